@@ -1,0 +1,338 @@
+//! Iterated local search: segment-swap (double-bridge) kicks followed by local search, accepted
+//! when not worse, run on several threads in epochs that end by adopting the best tour. Under a
+//! work budget the epochs are fixed counts of kicks, so a given seed and thread count always
+//! produce the same answer.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+use super::local::LocalSearch;
+use super::modes::optimize_modes;
+use super::neighbors::Neighbors;
+use super::net::Net;
+use super::tour::Tour;
+use crate::cost::{Cost, CostModel};
+
+/// Ruin-and-recreate kicks are used on instances up to this size (they cost O(n) each).
+const REBUILD_UP_TO: usize = 5000;
+
+/// Mode of `v`: as just reinserted, else as in the tour.
+fn mode_of(tour: &Tour, fresh: &[(u32, u32)], v: u32) -> u32 {
+    fresh.iter().find(|&&(x, _)| x == v).map_or(tour.mode[v as usize], |&(_, m)| m)
+}
+
+/// One search chain (one per thread): its current and best tours, random state and how long it
+/// has gone without improving.
+pub(crate) struct Chain {
+    pub cur: Tour,
+    pub best: Tour,
+    pub rng: Pcg64Mcg,
+    pub stagnation: u64,
+}
+
+impl Chain {
+    pub fn new(start: &Tour, seed: u64) -> Self {
+        Chain { cur: start.clone(), best: start.clone(), rng: Pcg64Mcg::seed_from_u64(seed), stagnation: 0 }
+    }
+
+    /// Adopts `tour` as both current and best.
+    pub fn adopt(&mut self, tour: &Tour) {
+        self.cur.clone_from(tour);
+        self.best.clone_from(tour);
+        self.stagnation = 0;
+    }
+}
+
+/// What one ILS run may spend.
+#[derive(Clone, Copy)]
+pub(crate) struct Budget {
+    pub kicks: u64,
+    pub deadline: Option<Instant>,
+}
+
+pub(crate) struct Ils<'a, 'p, C> {
+    net: &'a Net<'p, C>,
+    nb: &'a Neighbors,
+    eps: Cost,
+    /// Run the exact mode DP after each local search (when it is cheap enough).
+    dp_each_kick: bool,
+}
+
+impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
+    pub fn new(net: &'a Net<'p, C>, nb: &'a Neighbors, eps: Cost) -> Self {
+        let mm = net.p.max_modes();
+        let dp_each_kick = net.multi_mode && net.n * mm * mm <= 20_000;
+        Ils { net, nb, eps, dp_each_kick }
+    }
+
+    /// Brings a tour to a local optimum of the moves and the mode DP.
+    pub fn descend(&self, tour: &mut Tour, deadline: Option<Instant>) -> u64 {
+        let mut ls = LocalSearch::new(self.net, self.nb, self.eps);
+        ls.deadline = deadline;
+        ls.push_all(tour);
+        loop {
+            ls.run(tour);
+            if deadline.is_some_and(|d| Instant::now() >= d) {
+                break;
+            }
+            if !optimize_modes(self.net, tour, self.eps) {
+                break;
+            }
+            ls.push_all(tour);
+        }
+        ls.moves
+    }
+
+    /// Runs kicks on a chain's state and returns the kicks done.
+    pub fn run(&self, state: &mut Chain, budget: Budget, cancel: Option<&AtomicBool>) -> u64 {
+        let Chain { cur, best, rng, stagnation } = state;
+        let mut ls = LocalSearch::new(self.net, self.nb, self.eps);
+        ls.deadline = budget.deadline;
+        let n = cur.len();
+        let mut kicks = 0u64;
+        if n < 3 {
+            return 0;
+        }
+        while kicks < budget.kicks {
+            if kicks & 15 == 0 {
+                if budget.deadline.is_some_and(|d| Instant::now() >= d) {
+                    break;
+                }
+                if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+                    break;
+                }
+            }
+            kicks += 1;
+            if *stagnation >= 16 * n as u64 + 200 {
+                // Long stagnation: restart from a heavily perturbed copy of the best tour.
+                *stagnation = 0;
+                cur.clone_from(best);
+                cur.begin();
+                for _ in 0..(n / 6).max(2) {
+                    if n <= REBUILD_UP_TO {
+                        self.ruin_recreate(cur, rng, &mut ls);
+                    } else {
+                        self.kick(cur, rng, &mut ls);
+                    }
+                }
+                if self.dp_each_kick {
+                    optimize_modes(self.net, cur, self.eps);
+                }
+                ls.run(cur);
+                cur.commit();
+                continue;
+            }
+            let before = cur.cost;
+            cur.begin();
+            // Kicks grow stronger while the search stagnates.
+            let strength = 1 + (*stagnation / (4 * n as u64 + 50)).min(3) as usize;
+            let mut kicked = false;
+            let rebuild = n <= REBUILD_UP_TO && rng.gen_bool(0.5);
+            for _ in 0..strength {
+                kicked |= if rebuild { self.ruin_recreate(cur, rng, &mut ls) } else { self.kick(cur, rng, &mut ls) };
+            }
+            if !kicked {
+                cur.undo();
+                continue;
+            }
+            if self.dp_each_kick {
+                // give the kicked order its best modes before the local search can undo it
+                optimize_modes(self.net, cur, self.eps);
+            }
+            ls.run(cur);
+            if self.dp_each_kick && optimize_modes(self.net, cur, self.eps) {
+                ls.push_all(cur);
+                ls.run(cur);
+            }
+            *stagnation += 1;
+            if cur.cost <= before + self.eps * 0.5 {
+                cur.commit();
+                if cur.cost < best.cost - self.eps {
+                    *stagnation = 0;
+                    best.seq.copy_from_slice(&cur.seq);
+                    best.pos.copy_from_slice(&cur.pos);
+                    best.mode.copy_from_slice(&cur.mode);
+                    best.cost = cur.cost;
+                }
+            } else {
+                cur.undo();
+            }
+        }
+        kicks
+    }
+
+    /// A double-bridge kick: exchanges two short adjacent segments, if precedence and groups
+    /// allow. Dirty nodes go onto the local search queue.
+    fn kick(&self, tour: &mut Tour, rng: &mut Pcg64Mcg, ls: &mut LocalSearch<'_, '_, C>) -> bool {
+        let net = self.net;
+        let n = tour.len();
+        let max_len = (n / 2).clamp(1, 50);
+        for _attempt in 0..20 {
+            let l1 = rng.gen_range(1..=max_len);
+            let l2 = rng.gen_range(1..=max_len);
+            if l1 + l2 + 1 > n {
+                continue;
+            }
+            let mut i = rng.gen_range(1..=n - l1 - l2);
+            let mut j = i + l1 - 1;
+            let mut k = j + l2;
+            if net.has_groups {
+                let (bs, be) = ls.block(tour, i);
+                if be > bs && rng.gen_bool(0.5) {
+                    // a kick inside one group block
+                    i = rng.gen_range(bs..be);
+                    j = rng.gen_range(i..be);
+                    k = rng.gen_range(j + 1..=be);
+                } else {
+                    // cut only at block boundaries
+                    i = bs;
+                    j = ls.block(tour, j.max(i)).1;
+                    if j + 1 >= n {
+                        continue;
+                    }
+                    k = ls.block(tour, k.max(j + 1)).1;
+                }
+            }
+            if net.has_prec {
+                // grow the second segment only while it holds no successor of the first
+                match self.feasible_end(tour, i, j, k) {
+                    Some(kk) => k = kk,
+                    None => continue,
+                }
+            }
+            let (p, a, b, c, d, q) =
+                (tour.seq[i - 1], tour.seq[i], tour.seq[j], tour.seq[j + 1], tour.seq[k], tour.next_of_pos(k));
+            if !net.move_allowed(&tour.seq, &[(p, a), (b, c), (d, q)], i, k) {
+                continue;
+            }
+            let old = tour.arc(net, p, a) + tour.arc(net, b, c) + tour.arc(net, d, q);
+            let new = tour.arc(net, p, c) + tour.arc(net, d, a) + tour.arc(net, b, q);
+            tour.swap_adjacent(i, j, k);
+            tour.cost += new - old;
+            for x in [p, a, b, c, d, q] {
+                ls.push(x);
+            }
+            return true;
+        }
+        false
+    }
+
+    /// Ruin and recreate: removes a few neighbouring tasks and puts each back at its cheapest
+    /// feasible place with its best mode (precedence windows and groups respected).
+    fn ruin_recreate(&self, tour: &mut Tour, rng: &mut Pcg64Mcg, ls: &mut LocalSearch<'_, '_, C>) -> bool {
+        let net = self.net;
+        let n = tour.len();
+        let k = rng.gen_range(2..=6usize).min(n / 3);
+        if k == 0 {
+            return false;
+        }
+        let free = |v: u32| v != net.anchor && (!net.has_groups || net.group(v) == crate::model::NO_GROUP);
+        let v = tour.seq[rng.gen_range(1..n)];
+        if !free(v) {
+            return false;
+        }
+        let mut removed = vec![v];
+        for &u in self.nb.out(v).iter().chain(self.nb.inn(v)) {
+            if removed.len() >= k {
+                break;
+            }
+            if free(u) && !removed.contains(&u) && rng.gen_bool(0.7) {
+                removed.push(u);
+            }
+        }
+        for x in &removed {
+            let (p, q) = (tour.prev(*x), tour.next(*x));
+            ls.push(p);
+            ls.push(q);
+        }
+        let mut rest: Vec<u32> = tour.seq.iter().copied().filter(|x| !removed.contains(x)).collect();
+        // shuffle the insertion order, then put predecessors first
+        for a in (1..removed.len()).rev() {
+            removed.swap(a, rng.gen_range(0..=a));
+        }
+        if net.has_prec {
+            removed.sort_by_key(|&x| net.topo_rank[x as usize]);
+        }
+        let mut modes: Vec<(u32, u32)> = Vec::with_capacity(removed.len());
+        for (idx, &x) in removed.iter().enumerate() {
+            let (lo, hi) = self.window(&rest, x, &removed[idx + 1..]);
+            let mut best = (Cost::INFINITY, usize::MAX, 0u32);
+            for at in lo..=hi {
+                let c = rest[at];
+                let d = rest[if at + 1 == rest.len() { 0 } else { at + 1 }];
+                if net.has_groups && net.inside_group(c, d) {
+                    continue;
+                }
+                let (mc, md) = (mode_of(tour, &modes, c), mode_of(tour, &modes, d));
+                let base = net.arc(c, mc, d, md);
+                for m in 0..net.num_modes(x) {
+                    let add = net.arc(c, mc, x, m) + net.mode_cost(x, m) + net.arc(x, m, d, md) - base;
+                    if add < best.0 {
+                        best = (add, at, m);
+                    }
+                }
+            }
+            if best.1 == usize::MAX {
+                return false;
+            }
+            rest.insert(best.1 + 1, x);
+            modes.push((x, best.2));
+        }
+        tour.overwrite(net, &rest, &modes);
+        for x in removed {
+            ls.push(x);
+        }
+        true
+    }
+
+    /// Positions `lo..=hi` after which `x` may be inserted into `rest` (x not in it). `pending`
+    /// are removed tasks still to be reinserted (all later in topological order): the successors
+    /// of a pending successor count as successors of `x`.
+    fn window(&self, rest: &[u32], x: u32, pending: &[u32]) -> (usize, usize) {
+        let net = self.net;
+        if !net.has_prec {
+            return (0, rest.len() - 1);
+        }
+        let preds = net.predecessors(x);
+        let mut succs: Vec<u32> = Vec::new();
+        let mut stack: Vec<u32> = net.successors(x).to_vec();
+        while let Some(y) = stack.pop() {
+            if pending.contains(&y) {
+                stack.extend_from_slice(net.successors(y));
+            } else if !succs.contains(&y) {
+                succs.push(y);
+            }
+        }
+        let mut lo = 0;
+        let mut hi = rest.len() - 1;
+        for (i, &v) in rest.iter().enumerate() {
+            if preds.contains(&v) {
+                lo = i;
+            }
+            if succs.contains(&v) {
+                hi = hi.min(i.saturating_sub(1));
+            }
+        }
+        debug_assert!(lo <= hi, "precedence window empty for {x}: rest {rest:?} preds {preds:?} succs {succs:?}");
+        (lo, hi.max(lo))
+    }
+
+    /// The largest `k' <= k` such that segments i..=j and j+1..=k' can trade places (nothing in
+    /// the first precedes anything in the second), if any.
+    fn feasible_end(&self, tour: &Tour, i: usize, j: usize, k: usize) -> Option<usize> {
+        let net = self.net;
+        let mut end = k;
+        for t in i..=j {
+            for &s in net.successors(tour.seq[t]) {
+                let ps = tour.pos[s as usize] as usize;
+                if ps > j && ps <= end {
+                    end = ps - 1;
+                }
+            }
+        }
+        (end > j).then_some(end)
+    }
+}

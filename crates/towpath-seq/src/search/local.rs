@@ -1,0 +1,630 @@
+//! Local search: mode change, Or-opt (segment insertion, optionally reversed) and 2-opt, driven by
+//! a queue of "dirty" nodes (don't-look bits). Moves respect precedence (checked incrementally by
+//! marking the moved segment's successors or predecessors while scanning outwards) and
+//! consecutive groups (see [`Net::move_allowed`]).
+
+use std::collections::VecDeque;
+use std::time::Instant;
+
+use super::neighbors::Neighbors;
+use super::net::{Net, NO_REV};
+use super::tour::Tour;
+use crate::cost::{Cost, CostModel};
+
+/// Longest segment Or-opt moves.
+const MAX_SEGMENT: usize = 3;
+
+/// Longest segments the segment exchange considers.
+const SWAP_WINDOW: usize = 64;
+
+pub(crate) struct LocalSearch<'a, 'p, C> {
+    net: &'a Net<'p, C>,
+    nb: &'a Neighbors,
+    pub eps: Cost,
+    queue: VecDeque<u32>,
+    queued: Vec<bool>,
+    mark: Vec<u32>,
+    stamp: u32,
+    two_opt: bool,
+    /// Scan at most this many positions each way when precedence forces scanning.
+    scan_limit: usize,
+    pub deadline: Option<Instant>,
+    /// Moves applied since creation (for statistics).
+    pub moves: u64,
+}
+
+/// An improving Or-opt move found by the scans.
+#[derive(Clone, Copy)]
+struct Insertion {
+    k: usize,
+    reversed: bool,
+    mode: u32,
+    delta: Cost,
+}
+
+impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
+    pub fn new(net: &'a Net<'p, C>, nb: &'a Neighbors, eps: Cost) -> Self {
+        LocalSearch {
+            net,
+            nb,
+            eps,
+            queue: VecDeque::new(),
+            queued: vec![false; net.n],
+            mark: vec![0; net.n],
+            stamp: 0,
+            two_opt: net.reversal_symmetric && !net.has_prec,
+            scan_limit: 5000,
+            deadline: None,
+            moves: 0,
+        }
+    }
+
+    /// Marks a node dirty.
+    #[inline]
+    pub fn push(&mut self, v: u32) {
+        if !self.queued[v as usize] {
+            self.queued[v as usize] = true;
+            self.queue.push_back(v);
+        }
+    }
+
+    /// Marks every node dirty, in tour order.
+    pub fn push_all(&mut self, tour: &Tour) {
+        for i in 0..tour.len() {
+            self.push(tour.seq[i]);
+        }
+    }
+
+    /// Improves until no dirty node yields an improving move (or the deadline passes).
+    /// Returns true if anything improved.
+    pub fn run(&mut self, tour: &mut Tour) -> bool {
+        let mut improved = false;
+        let mut count = 0u32;
+        while let Some(v) = self.queue.pop_front() {
+            self.queued[v as usize] = false;
+            count += 1;
+            if count & 255 == 0 {
+                if let Some(d) = self.deadline {
+                    if Instant::now() >= d {
+                        self.clear();
+                        break;
+                    }
+                }
+            }
+            if tour.len() < 3 && !self.net.multi_mode {
+                continue;
+            }
+            if self.improve_node(tour, v) {
+                debug_assert!(
+                    (tour.cost - tour.full_cost(self.net)).abs() <= 1e-6 * tour.cost.abs().max(1.0),
+                    "tracked cost {} != full cost {}",
+                    tour.cost,
+                    tour.full_cost(self.net)
+                );
+                improved = true;
+                self.moves += 1;
+                self.push(v);
+            }
+        }
+        improved
+    }
+
+    /// Empties the queue.
+    pub fn clear(&mut self) {
+        while let Some(v) = self.queue.pop_front() {
+            self.queued[v as usize] = false;
+        }
+    }
+
+    fn improve_node(&mut self, tour: &mut Tour, v: u32) -> bool {
+        if self.net.multi_mode && self.try_mode(tour, v) {
+            return true;
+        }
+        if v == self.net.anchor {
+            // The anchor never moves, but its arcs can still change through 2-opt.
+            return self.two_opt && self.try_two_opt(tour, v);
+        }
+        if self.try_or_opt(tour, v) {
+            return true;
+        }
+        if self.two_opt && self.try_two_opt(tour, v) {
+            return true;
+        }
+        self.try_swap(tour, v)
+    }
+
+    /// Path-preserving 3-opt ("segment exchange", the SOP-3-exchange of Gambardella and Dorigo):
+    /// swaps two adjacent segments of any length up to `SWAP_WINDOW`, one of them starting or
+    /// ending at `v`. Precedence is checked incrementally with marks while the segments grow.
+    fn try_swap(&mut self, tour: &mut Tour, v: u32) -> bool {
+        let net = self.net;
+        let n = tour.len();
+        if n < 4 {
+            return false;
+        }
+        let pv = tour.pos[v as usize] as usize;
+        let w = SWAP_WINDOW.min(n);
+        let arc = |t: &Tour, a: usize, b: usize| t.arc(net, t.seq[a], t.seq[b % n]);
+        // Forward: h = pv - 1, L = [h+1..=i] starts at v, R = [i+1..=j].
+        if pv >= 1 {
+            let h = pv - 1;
+            self.stamp += 1;
+            let st = self.stamp;
+            let base_h = arc(tour, h, h + 1);
+            for i in h + 1..(h + 1 + w).min(n - 1) {
+                for &x in net.successors(tour.seq[i]) {
+                    self.mark[x as usize] = st;
+                }
+                let base_hi = base_h + arc(tour, i, i + 1);
+                let g1 = base_hi - arc(tour, h, i + 1);
+                for j in i + 1..(i + 1 + w).min(n) {
+                    if self.mark[tour.seq[j] as usize] == st {
+                        break;
+                    }
+                    let delta = arc(tour, j, h + 1) + arc(tour, i, j + 1) - arc(tour, j, j + 1) - g1;
+                    if delta < -self.eps && self.swap_cuts_ok(tour, h, i, j) {
+                        self.apply_swap(tour, h, i, j, delta);
+                        return true;
+                    }
+                }
+            }
+        }
+        // Backward: j = pv, R = [i+1..=j] ends at v, L = [h+1..=i].
+        {
+            let j = pv;
+            if j < 2 {
+                return false;
+            }
+            self.stamp += 1;
+            let st = self.stamp;
+            let base_j = arc(tour, j, j + 1);
+            let lo_i = j.saturating_sub(w).max(1);
+            let mut i = j;
+            while i > lo_i {
+                i -= 1;
+                for &x in net.predecessors(tour.seq[i + 1]) {
+                    self.mark[x as usize] = st;
+                }
+                let base_ij = base_j + arc(tour, i, i + 1);
+                let lo_h = i.saturating_sub(w);
+                let mut h = i;
+                while h > lo_h {
+                    h -= 1;
+                    if self.mark[tour.seq[h + 1] as usize] == st {
+                        break;
+                    }
+                    let delta =
+                        arc(tour, h, i + 1) + arc(tour, j, h + 1) + arc(tour, i, j + 1) - arc(tour, h, h + 1) - base_ij;
+                    if delta < -self.eps && self.swap_cuts_ok(tour, h, i, j) {
+                        self.apply_swap(tour, h, i, j, delta);
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    fn swap_cuts_ok(&self, tour: &Tour, h: usize, i: usize, j: usize) -> bool {
+        !self.net.has_groups
+            || self.net.move_allowed(
+                &tour.seq,
+                &[(tour.seq[h], tour.seq[h + 1]), (tour.seq[i], tour.seq[i + 1]), (tour.seq[j], tour.next_of_pos(j))],
+                h + 1,
+                j,
+            )
+    }
+
+    fn apply_swap(&mut self, tour: &mut Tour, h: usize, i: usize, j: usize, delta: Cost) {
+        let ends = [tour.seq[h], tour.seq[h + 1], tour.seq[i], tour.seq[i + 1], tour.seq[j], tour.next_of_pos(j)];
+        tour.swap_adjacent(h + 1, i, j);
+        tour.cost += delta;
+        for x in ends {
+            self.push(x);
+        }
+    }
+
+    /// Best mode for `v` where it stands.
+    fn try_mode(&mut self, tour: &mut Tour, v: u32) -> bool {
+        let net = self.net;
+        let nm = net.num_modes(v);
+        if nm < 2 {
+            return false;
+        }
+        let (p, q) = (tour.prev(v), tour.next(v));
+        let (mp, mq) = (tour.mode[p as usize], tour.mode[q as usize]);
+        let price = |m: u32| {
+            if p == v {
+                // single node tour
+                net.arc(v, m, v, m) + net.mode_cost(v, m)
+            } else {
+                net.arc(p, mp, v, m) + net.mode_cost(v, m) + net.arc(v, m, q, mq)
+            }
+        };
+        let cur_m = tour.mode[v as usize];
+        let cur = price(cur_m);
+        let mut best = (cur, cur_m);
+        for m in 0..nm {
+            if m != cur_m {
+                let c = price(m);
+                if c < best.0 - self.eps {
+                    best = (c, m);
+                }
+            }
+        }
+        if best.1 != cur_m {
+            tour.set_mode(v, best.1);
+            tour.cost += best.0 - cur;
+            self.push(p);
+            self.push(q);
+            return true;
+        }
+        false
+    }
+
+    fn try_or_opt(&mut self, tour: &mut Tour, v: u32) -> bool {
+        let n = tour.len();
+        let pv = tour.pos[v as usize] as usize;
+        if self.net.has_groups {
+            // a whole consecutive-group block moves as one segment
+            let (bs, be) = self.block(tour, pv);
+            if be - bs + 1 > MAX_SEGMENT
+                && (bs == pv || be == pv)
+                && bs >= 1
+                && n >= be - bs + 4
+                && self.try_segment(tour, bs, be)
+            {
+                return true;
+            }
+        }
+        for len in 1..=MAX_SEGMENT {
+            if n < len + 3 {
+                break;
+            }
+            // v first in the segment
+            if pv + len - 1 < n && self.try_segment(tour, pv, pv + len - 1) {
+                return true;
+            }
+            // v last in the segment
+            if len > 1 && pv >= len && self.try_segment(tour, pv + 1 - len, pv) {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Tries to move the segment at positions `i..=j` (never position 0) elsewhere.
+    fn try_segment(&mut self, tour: &mut Tour, i: usize, j: usize) -> bool {
+        let net = self.net;
+        let n = tour.len();
+        debug_assert!(i >= 1 && j < n && i <= j);
+        let (s, e) = (tour.seq[i], tour.seq[j]);
+        let p = tour.seq[i - 1];
+        let q = tour.next_of_pos(j);
+        let single = i == j;
+        let ms = tour.mode[s as usize];
+        let mut gain = tour.arc(net, p, s) + tour.arc(net, e, q) - tour.arc(net, p, q);
+        if single {
+            gain += net.mode_cost(s, ms);
+        }
+        if gain <= self.eps && !net.multi_mode && net.p.cost_model().is_symmetric() {
+            // with symmetric (metric-like) costs a move needs a positive removal gain
+            return false;
+        }
+        // Inside cost change when the segment is reversed (without reverse modes).
+        let rev_ok = !single && self.reversal_ok(tour, i, j);
+        let rev_inside = if rev_ok && !net.reversal_symmetric {
+            let mut d = 0.0;
+            for t in i..j {
+                let (a, b) = (tour.seq[t], tour.seq[t + 1]);
+                d += tour.arc(net, b, a) - tour.arc(net, a, b);
+            }
+            d
+        } else {
+            0.0
+        };
+        let best = if net.has_prec {
+            self.scan_insertions(tour, i, j, gain, rev_ok, rev_inside)
+        } else {
+            self.candidate_insertions(tour, i, j, gain, rev_ok, rev_inside)
+        };
+        let Some(ins) = best else { return false };
+        let k = ins.k;
+        let c = tour.seq[k];
+        let d = tour.next_of_pos(k);
+        debug_assert!(net.move_allowed(&tour.seq, &[(p, s), (e, q), (c, d)], i.min(k + 1), j.max(k)));
+        tour.move_segment(i, j, k, ins.reversed);
+        if single {
+            tour.set_mode(s, ins.mode);
+        } else if ins.reversed && net.reversal_symmetric {
+            let (lo, hi) = (tour.pos[e as usize] as usize, tour.pos[s as usize] as usize);
+            tour.reverse_modes(net, lo, hi);
+        }
+        tour.cost += ins.delta;
+        for x in [p, q, c, d, s, e] {
+            self.push(x);
+        }
+        true
+    }
+
+    /// Positions of the consecutive-group block around position `i` (just `i` if ungrouped).
+    /// Stops at position 0 and at the end: blocks never wrap.
+    pub fn block(&self, tour: &Tour, i: usize) -> (usize, usize) {
+        let net = self.net;
+        let (mut a, mut b) = (i, i);
+        while a > 1 && net.inside_group(tour.seq[a - 1], tour.seq[a]) {
+            a -= 1;
+        }
+        while b + 1 < tour.len() && net.inside_group(tour.seq[b], tour.seq[b + 1]) {
+            b += 1;
+        }
+        (a, b)
+    }
+
+    /// Can the segment be traversed backwards: no precedence inside it, and modes reversible when
+    /// the instance relies on reverse modes.
+    fn reversal_ok(&self, tour: &Tour, i: usize, j: usize) -> bool {
+        let net = self.net;
+        if net.has_prec {
+            for a in i..=j {
+                for b in a + 1..=j {
+                    if net.successors(tour.seq[a]).contains(&tour.seq[b]) {
+                        return false;
+                    }
+                }
+            }
+        }
+        if net.reversal_symmetric {
+            return true;
+        }
+        // Without reverse modes the order can still be reversed, each task keeping its mode.
+        let _ = NO_REV;
+        true
+    }
+
+    /// Cost of putting the segment `s..e` between `c` and `d`, forward or reversed, minus the
+    /// arc c→d. For a single node, also picks its best mode there.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn insertion_cost(
+        &self,
+        tour: &Tour,
+        s: u32,
+        e: u32,
+        c: u32,
+        d: u32,
+        reversed: bool,
+        rev_inside: Cost,
+    ) -> (Cost, u32) {
+        let net = self.net;
+        let (mc, md) = (tour.mode[c as usize], tour.mode[d as usize]);
+        let base = net.arc(c, mc, d, md);
+        if s == e {
+            let mut best = (Cost::INFINITY, tour.mode[s as usize]);
+            for m in 0..net.num_modes(s) {
+                let x = net.arc(c, mc, s, m) + net.mode_cost(s, m) + net.arc(s, m, d, md);
+                if x < best.0 {
+                    best = (x, m);
+                }
+            }
+            return (best.0 - base, best.1);
+        }
+        let (ms, me) = (tour.mode[s as usize], tour.mode[e as usize]);
+        let x = if !reversed {
+            net.arc(c, mc, s, ms) + net.arc(e, me, d, md)
+        } else if net.reversal_symmetric {
+            net.arc(c, mc, e, net.rev_mode(e, me)) + net.arc(s, net.rev_mode(s, ms), d, md)
+        } else {
+            net.arc(c, mc, e, me) + net.arc(s, ms, d, md) + rev_inside
+        };
+        (x - base, 0)
+    }
+
+    /// Or-opt by scanning outwards from the segment, stopping at the first precedence conflict.
+    fn scan_insertions(
+        &mut self,
+        tour: &Tour,
+        i: usize,
+        j: usize,
+        gain: Cost,
+        rev_ok: bool,
+        rev_inside: Cost,
+    ) -> Option<Insertion> {
+        let net = self.net;
+        let n = tour.len();
+        let (s, e) = (tour.seq[i], tour.seq[j]);
+        let mut best: Option<Insertion> = None;
+        let mut best_delta = -self.eps;
+        let (p, q) = (tour.seq[i - 1], tour.next_of_pos(j));
+        let mut consider = |k: usize, c: u32, d: u32, this: &Self| {
+            if net.has_groups && !net.move_allowed(&tour.seq, &[(p, s), (e, q), (c, d)], i.min(k + 1), j.max(k)) {
+                return;
+            }
+            for reversed in [false, true] {
+                if reversed && !rev_ok {
+                    break;
+                }
+                let (x, m) = this.insertion_cost(tour, s, e, c, d, reversed, rev_inside);
+                let delta = x - gain;
+                if delta < best_delta {
+                    best_delta = delta;
+                    best = Some(Insertion { k, reversed, mode: m, delta });
+                }
+            }
+        };
+        // Forward: the nodes passed over must not be successors of the segment.
+        self.stamp += 1;
+        let st = self.stamp;
+        for t in i..=j {
+            for &x in net.successors(tour.seq[t]) {
+                self.mark[x as usize] = st;
+            }
+        }
+        let hi = (j + self.scan_limit).min(n - 1);
+        for k in j + 1..=hi {
+            let c = tour.seq[k];
+            if self.mark[c as usize] == st {
+                break;
+            }
+            consider(k, c, tour.next_of_pos(k), self);
+        }
+        // Backward: the nodes passed over must not be predecessors of the segment.
+        self.stamp += 1;
+        let st = self.stamp;
+        for t in i..=j {
+            for &x in net.predecessors(tour.seq[t]) {
+                self.mark[x as usize] = st;
+            }
+        }
+        let lo = i.saturating_sub(1 + self.scan_limit);
+        let mut k = i - 1;
+        while k > lo {
+            k -= 1;
+            let d = tour.seq[k + 1];
+            if self.mark[d as usize] == st {
+                break;
+            }
+            consider(k, tour.seq[k], d, self);
+        }
+        best
+    }
+
+    /// Or-opt over candidate neighbours (no precedence).
+    fn candidate_insertions(
+        &mut self,
+        tour: &Tour,
+        i: usize,
+        j: usize,
+        gain: Cost,
+        rev_ok: bool,
+        rev_inside: Cost,
+    ) -> Option<Insertion> {
+        let net = self.net;
+        let n = tour.len();
+        let (s, e) = (tour.seq[i], tour.seq[j]);
+        let mut best: Option<Insertion> = None;
+        let mut best_delta = -self.eps;
+        // k: insert after position k; valid if k < i - 1 or k > j
+        let valid = |k: usize| k + 1 < i || k > j;
+        let (p, q) = (tour.seq[i - 1], tour.next_of_pos(j));
+        let mut consider = |k: usize, reversed: bool| {
+            if !valid(k) || (reversed && !rev_ok) {
+                return;
+            }
+            let c = tour.seq[k];
+            let d = tour.next_of_pos(k);
+            if net.has_groups && !net.move_allowed(&tour.seq, &[(p, s), (e, q), (c, d)], i.min(k + 1), j.max(k)) {
+                return;
+            }
+            let (x, m) = self.insertion_cost(tour, s, e, c, d, reversed, rev_inside);
+            let delta = x - gain;
+            if delta < best_delta {
+                best_delta = delta;
+                best = Some(Insertion { k, reversed, mode: m, delta });
+            }
+        };
+        let before = |c: u32| {
+            let pc = tour.pos[c as usize] as usize;
+            if pc == 0 {
+                n - 1
+            } else {
+                pc - 1
+            }
+        };
+        for &c in self.nb.inn(s) {
+            consider(tour.pos[c as usize] as usize, false); // c -> s
+        }
+        for &c in self.nb.out(e) {
+            consider(before(c), false); // e -> c
+        }
+        if rev_ok {
+            for &c in self.nb.inn(e) {
+                consider(tour.pos[c as usize] as usize, true); // c -> e
+            }
+            for &c in self.nb.out(s) {
+                consider(before(c), true); // s -> c
+            }
+        }
+        if net.depot != u32::MAX || (s == e && net.multi_mode) {
+            // next to the depot: start or end of an open route
+            consider(0, false);
+            consider(n - 1, false);
+            if rev_ok {
+                consider(0, true);
+                consider(n - 1, true);
+            }
+        }
+        best
+    }
+
+    /// 2-opt with neighbour lists (reversal-symmetric instances without precedence).
+    fn try_two_opt(&mut self, tour: &mut Tour, a: u32) -> bool {
+        let net = self.net;
+        let n = tour.len();
+        if n < 4 {
+            return false;
+        }
+        let ma = tour.mode[a as usize];
+        for dir in [true, false] {
+            // dir: consider arc a->next(a); otherwise prev(a)->a.
+            let b = if dir { tour.next(a) } else { tour.prev(a) };
+            let ab = if dir { tour.arc(net, a, b) } else { tour.arc(net, b, a) };
+            for &c in self.nb.out(a) {
+                if c == b {
+                    continue;
+                }
+                let mc = tour.mode[c as usize];
+                let rc = net.rev_mode(c, mc);
+                // new arc between a and c (c reversed relative to its current direction)
+                let ac = if dir { net.arc(a, ma, c, rc) } else { net.arc(c, rc, a, ma) };
+                let g1 = ab - ac;
+                if g1 <= self.eps {
+                    if !net.multi_mode {
+                        break;
+                    }
+                    continue;
+                }
+                let d = if dir { tour.next(c) } else { tour.prev(c) };
+                if d == a {
+                    continue;
+                }
+                let (mb, md) = (tour.mode[b as usize], tour.mode[d as usize]);
+                let rb = net.rev_mode(b, mb);
+                let cd = if dir { tour.arc(net, c, d) } else { tour.arc(net, d, c) };
+                let bd = if dir { net.arc(b, rb, d, md) } else { net.arc(d, md, b, rb) };
+                let delta = bd - cd - g1;
+                if delta < -self.eps {
+                    // reverse the stretch between the two removed arcs that avoids position 0
+                    let (pa, pc) = (tour.pos[a as usize] as usize, tour.pos[c as usize] as usize);
+                    let (lo, hi) = if dir {
+                        // a b ... c d  or  c d ... a b
+                        if pa < pc {
+                            (pa + 1, pc)
+                        } else {
+                            (pc + 1, pa)
+                        }
+                    } else if pa < pc {
+                        // b a ... d c -> reverse a..d
+                        (pa, pc - 1)
+                    } else {
+                        // d c ... b a -> reverse c..b
+                        (pc, pa - 1)
+                    };
+                    // the complement stretch gives the same arcs when this one holds position 0
+                    let (lo, hi) = if lo == 0 { (hi + 1, n - 1) } else { (lo, hi) };
+                    if lo == 0 || lo > hi || hi >= n || !net.move_allowed(&tour.seq, &[(a, b), (c, d)], lo, hi) {
+                        continue;
+                    }
+                    tour.reverse(lo, hi);
+                    tour.reverse_modes(net, lo, hi);
+                    tour.cost += delta;
+                    for x in [a, b, c, d] {
+                        self.push(x);
+                    }
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}

@@ -1,0 +1,295 @@
+//! towpath's own solver: construction, local search with modes and precedence, and iterated
+//! local search on several threads within a time or work budget.
+
+mod construct;
+mod ils;
+mod local;
+mod modes;
+mod neighbors;
+mod net;
+mod tour;
+
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use crate::cost::{Cost, CostModel};
+use crate::exact::solve_exact;
+use crate::model::{Problem, TaskId};
+use crate::solution::{check, Solution, Step, Violation};
+
+use ils::{Budget, Ils};
+use neighbors::Neighbors;
+use net::Net;
+use tour::Tour;
+
+/// Progress of a running solve, passed to [`SolveOptions::progress`].
+#[derive(Clone, Debug)]
+pub struct Progress {
+    /// Time since the solve started.
+    pub elapsed: Duration,
+    /// Best route cost so far.
+    pub best_cost: Cost,
+    /// Improvement kicks done so far.
+    pub iterations: u64,
+    /// Fraction of the budget used, in 0..=1.
+    pub fraction: f64,
+}
+
+/// A progress callback.
+pub type ProgressFn = Arc<dyn Fn(&Progress) + Send + Sync>;
+
+/// How long to search and how.
+#[derive(Clone)]
+pub struct SolveOptions {
+    /// Stop after this much wall time (default 10 s). `None` with `iterations` set runs the full
+    /// work budget whatever it takes.
+    pub time_limit: Option<Duration>,
+    /// Work budget: the number of improvement kicks (summed over threads). With a work budget
+    /// and no time limit the result depends only on the input, the seed and the thread count.
+    pub iterations: Option<u64>,
+    /// Seed for the random choices.
+    pub seed: u64,
+    /// Worker threads (default: the machine's available parallelism).
+    pub threads: usize,
+    /// A feasible route to start from; the answer is never worse than it.
+    pub initial: Option<Vec<Step>>,
+    /// Called after each epoch of the search.
+    pub progress: Option<ProgressFn>,
+    /// Set to true to stop the search early; the best route so far is returned.
+    pub cancel: Option<Arc<AtomicBool>>,
+    /// Problems with at most this many tasks (and at most 6 modes per task) are solved exactly
+    /// by dynamic programming instead (default 9).
+    pub exact_up_to: usize,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        SolveOptions {
+            time_limit: Some(Duration::from_secs(10)),
+            iterations: None,
+            seed: 1,
+            threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            initial: None,
+            progress: None,
+            cancel: None,
+            exact_up_to: 9,
+        }
+    }
+}
+
+impl std::fmt::Debug for SolveOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SolveOptions")
+            .field("time_limit", &self.time_limit)
+            .field("iterations", &self.iterations)
+            .field("seed", &self.seed)
+            .field("threads", &self.threads)
+            .field("initial", &self.initial.as_ref().map(|s| s.len()))
+            .finish()
+    }
+}
+
+/// What a solve returns.
+#[derive(Clone, Debug)]
+pub struct SolveReport {
+    /// The best route found, with its checked cost.
+    pub solution: Solution,
+    /// Cost of the initial route, if one was given.
+    pub initial_cost: Option<Cost>,
+    /// Cost after construction and the first local search.
+    pub first_local_optimum: Cost,
+    /// Improvement kicks done.
+    pub iterations: u64,
+    /// Wall time.
+    pub elapsed: Duration,
+    /// True if the exact solver was used (the answer is optimal).
+    pub exact: bool,
+}
+
+/// Why a solve failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SolveError {
+    /// The initial route given is not feasible.
+    #[error("the initial route is not feasible: {0}")]
+    BadInitial(Violation),
+    /// No feasible route was found (every route uses a forbidden transition).
+    #[error("no feasible route found: {0}")]
+    NoFeasibleRoute(Violation),
+}
+
+/// Solves a problem with towpath's best solver.
+pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<SolveReport, SolveError> {
+    let t0 = Instant::now();
+    let deadline = opts.time_limit.map(|d| t0 + d);
+    let initial_cost = match &opts.initial {
+        Some(steps) => Some(check(problem, steps).map_err(SolveError::BadInitial)?),
+        None => None,
+    };
+    let n = problem.num_tasks();
+    if n <= opts.exact_up_to.min(crate::MAX_EXACT_TASKS) && problem.max_modes() <= 6 {
+        if let Ok(Some(sol)) = solve_exact(problem) {
+            let cost = check(problem, &sol.steps).map_err(SolveError::NoFeasibleRoute)?;
+            return Ok(SolveReport {
+                solution: Solution { steps: sol.steps, cost },
+                initial_cost,
+                first_local_optimum: cost,
+                iterations: 0,
+                elapsed: t0.elapsed(),
+                exact: true,
+            });
+        }
+    }
+    let net = Net::new(problem);
+    let threads = opts.threads.max(1);
+
+    // Construction: nearest neighbour from a seed pool sized to the budget, a space-filling
+    // curve for very large instances, and the initial route if given.
+    let mut starts: Vec<Tour> = Vec::new();
+    let work = (n as f64).powi(2) * problem.max_modes() as f64;
+    if n > 12_000 {
+        if let Some((seq, mode)) = construct::space_filling(&net) {
+            starts.push(Tour::new(&net, seq, mode));
+        }
+    }
+    if starts.is_empty() {
+        let pool_size = ((2e7 / work.max(1.0)) as usize).clamp(1, 64);
+        let pool = if net.depot != u32::MAX && problem.start().is_some() {
+            vec![0]
+        } else {
+            construct::seed_pool(&net, pool_size)
+        };
+        for f in pool {
+            let (seq, mode) = construct::nearest_neighbor(&net, Some(f));
+            if seq.len() == net.n {
+                starts.push(Tour::new(&net, seq, mode));
+            }
+        }
+    }
+    if let Some(steps) = &opts.initial {
+        starts.push(tour_from_steps(&net, steps));
+    }
+    let eps = {
+        let c = starts.iter().map(|t| t.cost).filter(|c| c.is_finite()).fold(0.0, f64::max);
+        1e-9 * (c / n.max(1) as f64).max(1.0)
+    };
+    let k = if n > 20_000 { 8 } else { 10 };
+    let nb = Neighbors::build(&net, k);
+    let ils = Ils::new(&net, &nb, eps);
+    // Descend from the best few starts; keep the best local optimum.
+    starts.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+    let keep = if opts.initial.is_some() { starts.len() } else { starts.len().min(3) };
+    let mut best: Option<Tour> = None;
+    for (idx, mut t) in starts.into_iter().enumerate() {
+        let is_initial = opts.initial.is_some() && idx + 1 == keep;
+        if idx >= keep && !is_initial {
+            continue;
+        }
+        ils.descend(&mut t, deadline);
+        if best.as_ref().is_none_or(|b| t.cost < b.cost) {
+            best = Some(t);
+        }
+    }
+    let mut best = best.expect("at least one start");
+    let first_local_optimum = best.cost;
+
+    // Iterated local search in epochs.
+    let mut iterations = 0u64;
+    let total_kicks = opts.iterations.unwrap_or(u64::MAX);
+    let epochs_planned = 20u64;
+    let per_epoch = match opts.iterations {
+        Some(it) => (it / (epochs_planned * threads as u64)).max(1),
+        None => u64::MAX,
+    };
+    let slice =
+        opts.time_limit.map(|d| (d / epochs_planned as u32).clamp(Duration::from_millis(50), Duration::from_secs(2)));
+    let mut chains: Vec<ils::Chain> = (0..threads)
+        .map(|t| ils::Chain::new(&best, opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ t as u64))
+        .collect();
+    while iterations < total_kicks {
+        if deadline.is_some_and(|d| Instant::now() >= d) {
+            break;
+        }
+        if opts.cancel.as_ref().is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+            break;
+        }
+        let epoch_deadline = match (deadline, slice) {
+            (Some(d), Some(s)) => Some(d.min(Instant::now() + s)),
+            _ => None,
+        };
+        let left = total_kicks - iterations;
+        let kicks_each = per_epoch.min(left.div_ceil(threads as u64));
+        let budget = Budget { kicks: kicks_each, deadline: epoch_deadline };
+        let cancel = opts.cancel.as_deref();
+        let done: u64 = if threads == 1 {
+            ils.run(&mut chains[0], budget, cancel)
+        } else {
+            std::thread::scope(|s| {
+                let handles: Vec<_> = chains
+                    .iter_mut()
+                    .map(|chain| {
+                        let ils = &ils;
+                        s.spawn(move || ils.run(chain, budget, cancel))
+                    })
+                    .collect();
+                handles.into_iter().map(|h| h.join().expect("solver thread panicked")).sum()
+            })
+        };
+        // The best chain wins (lowest index on ties); chains that fell behind adopt it.
+        for c in chains.iter() {
+            if c.best.cost < best.cost - eps {
+                best.clone_from(&c.best);
+            }
+        }
+        for c in chains.iter_mut() {
+            if c.best.cost > best.cost + eps {
+                c.adopt(&best);
+            }
+        }
+        iterations += done;
+        if let Some(cb) = &opts.progress {
+            let fraction = match (opts.time_limit, opts.iterations) {
+                (Some(tl), _) if opts.iterations.is_none() => t0.elapsed().as_secs_f64() / tl.as_secs_f64(),
+                (_, Some(it)) => iterations as f64 / it as f64,
+                _ => 0.0,
+            };
+            cb(&Progress { elapsed: t0.elapsed(), best_cost: best.cost, iterations, fraction: fraction.min(1.0) });
+        }
+        if done == 0 {
+            break;
+        }
+    }
+    optimize_final(&net, &mut best, eps);
+    let steps = steps_from_tour(&net, &best);
+    let cost = check(problem, &steps).map_err(SolveError::NoFeasibleRoute)?;
+    let mut solution = Solution { steps, cost };
+    if let (Some(init), Some(ic)) = (&opts.initial, initial_cost) {
+        if ic < solution.cost {
+            solution = Solution { steps: init.clone(), cost: ic };
+        }
+    }
+    Ok(SolveReport { solution, initial_cost, first_local_optimum, iterations, elapsed: t0.elapsed(), exact: false })
+}
+
+fn optimize_final<C: CostModel>(net: &Net<C>, tour: &mut Tour, eps: Cost) {
+    modes::optimize_modes(net, tour, eps);
+    tour.cost = tour.full_cost(net);
+}
+
+fn tour_from_steps<C: CostModel>(net: &Net<C>, steps: &[Step]) -> Tour {
+    let mut seq = Vec::with_capacity(net.n);
+    let mut mode = vec![0u32; net.n];
+    if net.depot != u32::MAX {
+        seq.push(net.depot);
+    }
+    for s in steps {
+        seq.push(s.task.0);
+        mode[s.task.index()] = s.mode;
+    }
+    construct::rotate_to_anchor(net, &mut seq);
+    Tour::new(net, seq, mode)
+}
+
+fn steps_from_tour<C: CostModel>(net: &Net<C>, tour: &Tour) -> Vec<Step> {
+    tour.nodes().filter(|&(v, _)| v != net.depot).map(|(v, m)| Step { task: TaskId(v), mode: m }).collect()
+}

@@ -1,0 +1,171 @@
+//! Candidate neighbour lists: for each task, the few tasks it is cheapest to go to (out) and to
+//! come from (in). Built from a k-d tree when the cost model has positions, else by scanning.
+
+use kiddo::immutable::float::kdtree::ImmutableKdTree;
+use kiddo::SquaredEuclidean;
+
+use super::net::Net;
+use crate::cost::{Cost, CostModel, StateId};
+use crate::model::TaskId;
+
+pub(crate) struct Neighbors {
+    k: usize,
+    out: Vec<u32>,
+    inn: Vec<u32>,
+    symmetric: bool,
+}
+
+impl Neighbors {
+    /// Tasks cheapest to go to from `v` (best first). Empty for the depot.
+    #[inline]
+    pub fn out(&self, v: u32) -> &[u32] {
+        let a = v as usize * self.k;
+        if a >= self.out.len() {
+            return &[];
+        }
+        trim(&self.out[a..a + self.k])
+    }
+
+    /// Tasks cheapest to come from into `v` (best first).
+    #[inline]
+    pub fn inn(&self, v: u32) -> &[u32] {
+        if self.symmetric {
+            return self.out(v);
+        }
+        let a = v as usize * self.k;
+        if a >= self.inn.len() {
+            return &[];
+        }
+        trim(&self.inn[a..a + self.k])
+    }
+
+    pub fn build<C: CostModel>(net: &Net<C>, k: usize) -> Self {
+        let n = net.n_tasks;
+        let k = k.min(n.saturating_sub(1)).max(1);
+        let symmetric = net.p.cost_model().is_symmetric();
+        let positions = spatial_points(net);
+        let candidates: Vec<Vec<u32>> = match &positions {
+            Some((pts, owner)) => kd_candidates(net, pts, owner, k),
+            None => Vec::new(),
+        };
+        let mut out = vec![u32::MAX; n * k];
+        let mut inn = if symmetric { Vec::new() } else { vec![u32::MAX; n * k] };
+        let mut scored: Vec<(Cost, u32)> = Vec::with_capacity(n);
+        for v in 0..n as u32 {
+            // out
+            scored.clear();
+            let pool: Box<dyn Iterator<Item = u32>> = if positions.is_some() {
+                Box::new(candidates[v as usize].iter().copied())
+            } else {
+                Box::new(0..n as u32)
+            };
+            let pool: Vec<u32> = pool.filter(|&u| u != v).collect();
+            for &u in &pool {
+                scored.push((min_arc(net, v, u), u));
+            }
+            fill(&mut out[v as usize * k..(v as usize + 1) * k], &mut scored);
+            if !symmetric {
+                scored.clear();
+                for &u in &pool {
+                    scored.push((min_arc(net, u, v), u));
+                }
+                fill(&mut inn[v as usize * k..(v as usize + 1) * k], &mut scored);
+            }
+        }
+        Neighbors { k, out, inn, symmetric }
+    }
+}
+
+fn trim(s: &[u32]) -> &[u32] {
+    let end = s.iter().position(|&x| x == u32::MAX).unwrap_or(s.len());
+    &s[..end]
+}
+
+fn fill(dst: &mut [u32], scored: &mut [(Cost, u32)]) {
+    let k = dst.len().min(scored.len());
+    if k == 0 {
+        return;
+    }
+    if scored.len() > k {
+        scored.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    }
+    let best = &mut scored[..k];
+    best.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    for (d, s) in dst.iter_mut().zip(best.iter()) {
+        *d = s.1;
+    }
+}
+
+/// Cheapest transition from any mode of `a` to any mode of `b`.
+fn min_arc<C: CostModel>(net: &Net<C>, a: u32, b: u32) -> Cost {
+    let mut best = Cost::INFINITY;
+    for ma in 0..net.num_modes(a) {
+        for mb in 0..net.num_modes(b) {
+            let c = net.arc(a, ma, b, mb);
+            if c < best {
+                best = c;
+            }
+        }
+    }
+    best
+}
+
+/// Points of every mode's entry and exit state, with the task that owns each, if the cost model
+/// has positions for all of them.
+fn spatial_points<C: CostModel>(net: &Net<C>) -> Option<(Vec<[f64; 3]>, Vec<u32>)> {
+    let n = net.n_tasks;
+    // A k-d tree pays off only on larger instances.
+    if n < 600 {
+        return None;
+    }
+    let cm = net.p.cost_model();
+    let mut pts = Vec::new();
+    let mut owner = Vec::new();
+    let mut seen: Vec<StateId> = Vec::new();
+    for t in 0..n as u32 {
+        seen.clear();
+        for m in net.p.modes(TaskId(t)) {
+            for s in [m.entry, m.exit] {
+                if seen.contains(&s) {
+                    continue;
+                }
+                seen.push(s);
+                let p = cm.position(s)?;
+                if !p.iter().all(|x| x.is_finite()) {
+                    return None;
+                }
+                pts.push(p);
+                owner.push(t);
+            }
+        }
+    }
+    Some((pts, owner))
+}
+
+fn kd_candidates<C: CostModel>(net: &Net<C>, pts: &[[f64; 3]], owner: &[u32], k: usize) -> Vec<Vec<u32>> {
+    let tree: ImmutableKdTree<f64, u32, 3, 32> = ImmutableKdTree::new_from_slice(pts);
+    let n = net.n_tasks;
+    let mut by_task: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (i, &t) in owner.iter().enumerate() {
+        by_task[t as usize].push(i);
+    }
+    let mut out = Vec::with_capacity(n);
+    let mut mark = vec![u32::MAX; n];
+    for (t, idxs) in by_task.iter().enumerate() {
+        mark[t] = t as u32;
+        // Ask for enough points to see about 2k other tasks even when tasks have many states.
+        let per_point = (2 * k + 1) * idxs.len().max(1) + 4;
+        let mut cands: Vec<u32> = Vec::new();
+        for &i in idxs {
+            for nn in tree.nearest_n::<SquaredEuclidean>(&pts[i], per_point.min(pts.len())) {
+                let u = owner[nn.item as usize];
+                if mark[u as usize] != t as u32 {
+                    mark[u as usize] = t as u32;
+                    cands.push(u);
+                }
+            }
+        }
+        out.push(cands);
+    }
+    out
+}

@@ -1,0 +1,271 @@
+//! The solvers' view of a problem: a cyclic sequence of *nodes* with position 0 fixed.
+//!
+//! Node `t < n_tasks` is task `t`. When the problem has a start state or an open end, an extra
+//! *depot* node (id `n_tasks`) sits at position 0 and prices the way in and out; a closed tour
+//! without a start state instead fixes an *anchor* task at position 0. Pinned first/last tasks
+//! become precedence edges, so every move that keeps precedence keeps them too.
+
+use crate::cost::{Cost, CostModel, StateId};
+use crate::model::{End, Problem, TaskId, NO_GROUP};
+
+/// Marks "no reverse mode".
+pub(crate) const NO_REV: u32 = u32::MAX;
+
+pub(crate) struct Net<'p, C> {
+    pub p: &'p Problem<C>,
+    /// Tasks in the problem.
+    pub n_tasks: usize,
+    /// Nodes in the tour (tasks plus depot, if any).
+    pub n: usize,
+    /// Id of the depot node, or `u32::MAX` if there is none.
+    pub depot: u32,
+    /// The node fixed at position 0.
+    pub anchor: u32,
+    /// Where the way out of the last node goes, if it is priced.
+    back: Option<StateId>,
+    /// Reverse mode of each (task, mode), indexed by the global mode index.
+    rev: Vec<u32>,
+    mode_base: Vec<u32>,
+    /// Every mode of every task has a reverse mode of equal cost, and the cost model is
+    /// symmetric: reversing a stretch of the tour (with modes swapped) leaves its inside cost
+    /// unchanged.
+    pub reversal_symmetric: bool,
+    /// Precedence including pins, in compressed form.
+    succ_off: Vec<u32>,
+    succ: Vec<u32>,
+    pred_off: Vec<u32>,
+    pred: Vec<u32>,
+    pub has_prec: bool,
+    /// Rank of each node in a topological order of the precedence (with pins).
+    pub topo_rank: Vec<u32>,
+    /// Consecutive group per node (`NO_GROUP` if none; the depot has none).
+    group: Vec<u32>,
+    pub has_groups: bool,
+    pub multi_mode: bool,
+}
+
+impl<'p, C: CostModel> Net<'p, C> {
+    pub fn new(p: &'p Problem<C>) -> Self {
+        let n_tasks = p.num_tasks();
+        let cyclic = p.is_cyclic();
+        let (n, depot, anchor) = if cyclic {
+            let anchor = p.first_task().map_or(0, |t| t.0);
+            (n_tasks, u32::MAX, anchor)
+        } else {
+            (n_tasks + 1, n_tasks as u32, n_tasks as u32)
+        };
+        let back = match p.end() {
+            End::Free => None,
+            End::At(e) => Some(e),
+            End::Closed => p.start(),
+        };
+        // Reverse modes.
+        let mut mode_base = Vec::with_capacity(n_tasks + 1);
+        let mut rev = Vec::new();
+        let mut all_rev = true;
+        for t in p.tasks() {
+            mode_base.push(rev.len() as u32);
+            let ms = p.modes(t);
+            for m in ms {
+                let r = ms
+                    .iter()
+                    .position(|o| o.entry == m.exit && o.exit == m.entry && o.cost == m.cost)
+                    .map_or(NO_REV, |k| k as u32);
+                all_rev &= r != NO_REV;
+                rev.push(r);
+            }
+        }
+        mode_base.push(rev.len() as u32);
+        let reversal_symmetric = all_rev && p.cost_model().is_symmetric();
+
+        // Precedence with pins.
+        let mut edges: Vec<(u32, u32)> = Vec::new();
+        for t in p.tasks() {
+            for s in p.precedence().successors(t) {
+                edges.push((t.0, s.0));
+            }
+        }
+        if !cyclic {
+            if let Some(f) = p.first_task() {
+                edges.extend((0..n_tasks as u32).filter(|&x| x != f.0).map(|x| (f.0, x)));
+            }
+        }
+        if let Some(l) = p.last_task() {
+            edges.extend((0..n_tasks as u32).filter(|&x| x != l.0 && x != anchor).map(|x| (x, l.0)));
+        }
+        edges.sort_unstable();
+        edges.dedup();
+        let has_prec = !edges.is_empty();
+        let (succ_off, succ) = csr(n, edges.iter().copied());
+        let (pred_off, pred) = csr(n, edges.iter().map(|&(a, b)| (b, a)));
+
+        let topo_rank = topological_rank(n, &succ_off, &succ, &pred_off);
+        let mut group = vec![NO_GROUP; n];
+        for t in p.tasks() {
+            if let Some(g) = p.group_of(t) {
+                group[t.index()] = g as u32;
+            }
+        }
+        Net {
+            p,
+            n_tasks,
+            n,
+            depot,
+            anchor,
+            back,
+            rev,
+            mode_base,
+            reversal_symmetric,
+            succ_off,
+            succ,
+            pred_off,
+            pred,
+            has_prec,
+            topo_rank,
+            group,
+            has_groups: !p.groups().is_empty(),
+            multi_mode: p.max_modes() > 1,
+        }
+    }
+
+    /// Number of modes of a node (the depot has one).
+    #[inline]
+    pub fn num_modes(&self, v: u32) -> u32 {
+        if v == self.depot {
+            1
+        } else {
+            self.mode_base[v as usize + 1] - self.mode_base[v as usize]
+        }
+    }
+
+    /// Internal cost of a node in a mode.
+    #[inline]
+    pub fn mode_cost(&self, v: u32, m: u32) -> Cost {
+        if v == self.depot {
+            0.0
+        } else {
+            self.p.modes(TaskId(v))[m as usize].cost
+        }
+    }
+
+    /// Transition cost from node `a` in mode `ma` to node `b` in mode `mb`.
+    #[inline]
+    pub fn arc(&self, a: u32, ma: u32, b: u32, mb: u32) -> Cost {
+        if a == self.depot {
+            if b == self.depot {
+                return match (self.p.start(), self.back) {
+                    (Some(s), Some(e)) => self.p.transition(s, e),
+                    _ => 0.0,
+                };
+            }
+            match self.p.start() {
+                Some(s) => self.p.transition(s, self.p.modes(TaskId(b))[mb as usize].entry),
+                None => 0.0,
+            }
+        } else if b == self.depot {
+            match self.back {
+                Some(e) => self.p.transition(self.p.modes(TaskId(a))[ma as usize].exit, e),
+                None => 0.0,
+            }
+        } else {
+            self.p.transition(self.p.modes(TaskId(a))[ma as usize].exit, self.p.modes(TaskId(b))[mb as usize].entry)
+        }
+    }
+
+    /// The reverse mode of `(v, m)`, or `NO_REV`.
+    #[inline]
+    pub fn rev_mode(&self, v: u32, m: u32) -> u32 {
+        if v == self.depot {
+            0
+        } else {
+            self.rev[(self.mode_base[v as usize] + m) as usize]
+        }
+    }
+
+    #[inline]
+    pub fn successors(&self, v: u32) -> &[u32] {
+        &self.succ[self.succ_off[v as usize] as usize..self.succ_off[v as usize + 1] as usize]
+    }
+
+    #[inline]
+    pub fn predecessors(&self, v: u32) -> &[u32] {
+        &self.pred[self.pred_off[v as usize] as usize..self.pred_off[v as usize + 1] as usize]
+    }
+
+    /// The consecutive group of a node.
+    #[inline]
+    pub fn group(&self, v: u32) -> u32 {
+        self.group[v as usize]
+    }
+
+    /// True if the arc between `a` and `b` lies inside one consecutive group.
+    #[inline]
+    pub fn inside_group(&self, a: u32, b: u32) -> bool {
+        let g = self.group[a as usize];
+        g != NO_GROUP && g == self.group[b as usize]
+    }
+
+    /// Does a move keep every consecutive group contiguous? It removes `arcs` (given by their end
+    /// nodes) and rearranges only positions `lo..=hi` of `seq`. It does if all removed arcs join
+    /// different groups (whole blocks move), or all lie inside one group, or the rearranged
+    /// positions all belong to one group.
+    pub fn move_allowed(&self, seq: &[u32], arcs: &[(u32, u32)], lo: usize, hi: usize) -> bool {
+        if !self.has_groups || self.cuts_allowed(arcs) {
+            return true;
+        }
+        let g = self.group[seq[lo] as usize];
+        g != NO_GROUP && seq[lo..=hi].iter().all(|&x| self.group[x as usize] == g)
+    }
+
+    fn cuts_allowed(&self, arcs: &[(u32, u32)]) -> bool {
+        if !self.has_groups {
+            return true;
+        }
+        let inside: Vec<bool> = arcs.iter().map(|&(a, b)| self.inside_group(a, b)).collect();
+        if inside.iter().all(|&x| !x) {
+            return true;
+        }
+        if inside.iter().all(|&x| x) {
+            let g = self.group[arcs[0].0 as usize];
+            return arcs.iter().all(|&(a, _)| self.group[a as usize] == g);
+        }
+        false
+    }
+}
+
+/// Kahn's algorithm over the compressed adjacency; nodes on a cycle (impossible after model
+/// validation) keep rank `u32::MAX`.
+fn topological_rank(n: usize, succ_off: &[u32], succ: &[u32], pred_off: &[u32]) -> Vec<u32> {
+    let mut indeg: Vec<u32> = (0..n).map(|v| pred_off[v + 1] - pred_off[v]).collect();
+    let mut stack: Vec<u32> = (0..n as u32).filter(|&v| indeg[v as usize] == 0).collect();
+    let mut rank = vec![u32::MAX; n];
+    let mut r = 0;
+    while let Some(v) = stack.pop() {
+        rank[v as usize] = r;
+        r += 1;
+        for &s in &succ[succ_off[v as usize] as usize..succ_off[v as usize + 1] as usize] {
+            indeg[s as usize] -= 1;
+            if indeg[s as usize] == 0 {
+                stack.push(s);
+            }
+        }
+    }
+    rank
+}
+
+fn csr(n: usize, edges: impl Iterator<Item = (u32, u32)> + Clone) -> (Vec<u32>, Vec<u32>) {
+    let mut off = vec![0u32; n + 1];
+    for (a, _) in edges.clone() {
+        off[a as usize + 1] += 1;
+    }
+    for i in 0..n {
+        off[i + 1] += off[i];
+    }
+    let mut fill = off.clone();
+    let mut out = vec![0u32; off[n] as usize];
+    for (a, b) in edges {
+        out[fill[a as usize] as usize] = b;
+        fill[a as usize] += 1;
+    }
+    (off, out)
+}
