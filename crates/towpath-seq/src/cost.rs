@@ -40,7 +40,7 @@ pub trait CostModel: Send + Sync {
     }
 
     /// A point in R³ for the state, if the model has one. Used only to build spatial neighbour
-    /// lists (a k-d tree) instead of scanning all pairs; the cost itself always comes from
+    /// lists (a spatial tree) instead of scanning all pairs; the cost itself always comes from
     /// [`CostModel::cost`].
     fn position(&self, _state: StateId) -> Option<[f64; 3]> {
         None
@@ -200,6 +200,36 @@ impl PointCost {
     }
 }
 
+/// Smallest integer not below `x` (x ≥ 0), without a libm call. For TSPLIB's `ATT` this equals
+/// its "nint, plus one if below" rule.
+#[inline]
+fn ceil_pos(x: f64) -> f64 {
+    let t = x as i64 as f64;
+    if t < x {
+        t + 1.0
+    } else {
+        t
+    }
+}
+
+impl PointCost {
+    /// TSPLIB's geographical distance (kept out of line: it is rare and large).
+    #[cold]
+    #[inline(never)]
+    fn geo_cost(&self, from: StateId, to: StateId) -> Cost {
+        if from == to {
+            return 0.0;
+        }
+        const RRR: f64 = 6378.388;
+        let [lat1, lon1] = self.geo[from.index()];
+        let [lat2, lon2] = self.geo[to.index()];
+        let q1 = (lon1 - lon2).cos();
+        let q2 = (lat1 - lat2).cos();
+        let q3 = (lat1 + lat2).cos();
+        (RRR * (0.5 * ((1.0 + q1) * q2 - (1.0 - q1) * q3)).acos() + 1.0).floor()
+    }
+}
+
 /// TSPLIB's conversion of `DDD.MM` to radians (with its value of π).
 fn geo_radians(x: f64) -> f64 {
     // TSPLIB's reference code uses this truncated value; distances must match it exactly.
@@ -210,10 +240,11 @@ fn geo_radians(x: f64) -> f64 {
     PI * (deg + 5.0 * min / 3.0) / 180.0
 }
 
-/// TSPLIB's `nint`: round half up, as `(int)(x + 0.5)` in the reference code.
+/// TSPLIB's `nint`: round half up, as `(int)(x + 0.5)` in the reference code (x ≥ 0 here, so
+/// truncation is the floor; the cast avoids a libm call on baseline x86-64).
 #[inline]
 fn nint(x: f64) -> f64 {
-    (x + 0.5).floor()
+    (x + 0.5) as i64 as f64
 }
 
 impl CostModel for PointCost {
@@ -221,7 +252,7 @@ impl CostModel for PointCost {
         self.points.len()
     }
 
-    #[inline]
+    #[inline(always)]
     fn cost(&self, from: StateId, to: StateId) -> Cost {
         let a = &self.points[from.index()];
         let b = &self.points[to.index()];
@@ -229,31 +260,12 @@ impl CostModel for PointCost {
         match self.metric {
             Metric::Euclidean => (dx * dx + dy * dy + dz * dz).sqrt(),
             Metric::EuclideanNint => nint((dx * dx + dy * dy + dz * dz).sqrt()),
-            Metric::EuclideanCeil => (dx * dx + dy * dy + dz * dz).sqrt().ceil(),
-            Metric::Att => {
-                let r = ((dx * dx + dy * dy) / 10.0).sqrt();
-                let t = nint(r);
-                if t < r {
-                    t + 1.0
-                } else {
-                    t
-                }
-            }
+            Metric::EuclideanCeil => ceil_pos((dx * dx + dy * dy + dz * dz).sqrt()),
+            Metric::Att => ceil_pos(((dx * dx + dy * dy) / 10.0).sqrt()),
             Metric::Manhattan => dx.abs() + dy.abs() + dz.abs(),
             Metric::ManhattanNint => nint(dx.abs() + dy.abs() + dz.abs()),
             Metric::MaximumNint => nint(dx.abs().max(dy.abs()).max(dz.abs())),
-            Metric::Geo => {
-                if from == to {
-                    return 0.0;
-                }
-                const RRR: f64 = 6378.388;
-                let [lat1, lon1] = self.geo[from.index()];
-                let [lat2, lon2] = self.geo[to.index()];
-                let q1 = (lon1 - lon2).cos();
-                let q2 = (lat1 - lat2).cos();
-                let q3 = (lat1 + lat2).cos();
-                (RRR * (0.5 * ((1.0 + q1) * q2 - (1.0 - q1) * q3)).acos() + 1.0).floor()
-            }
+            Metric::Geo => self.geo_cost(from, to),
         }
     }
 

@@ -16,6 +16,9 @@ use super::net::Net;
 use super::tour::Tour;
 use crate::cost::{Cost, CostModel};
 
+/// Longest segment a double-bridge kick moves.
+const KICK_SEGMENT: usize = 50;
+
 /// Ruin-and-recreate kicks are used on instances up to this size (they cost O(n) each).
 const REBUILD_UP_TO: usize = 5000;
 
@@ -59,13 +62,17 @@ pub(crate) struct Ils<'a, 'p, C> {
     eps: Cost,
     /// Run the exact mode DP after each local search (when it is cheap enough).
     dp_each_kick: bool,
+    /// Use ruin-and-recreate kicks (for precedence, groups or modes, where double bridges
+    /// are often infeasible or blind to modes).
+    rebuild: bool,
 }
 
 impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
     pub fn new(net: &'a Net<'p, C>, nb: &'a Neighbors, eps: Cost) -> Self {
         let mm = net.p.max_modes();
         let dp_each_kick = net.multi_mode && net.n * mm * mm <= 20_000;
-        Ils { net, nb, eps, dp_each_kick }
+        let rebuild = net.n <= REBUILD_UP_TO && (net.has_prec || net.has_groups || net.multi_mode);
+        Ils { net, nb, eps, dp_each_kick, rebuild }
     }
 
     /// Brings a tour to a local optimum of the moves and the mode DP.
@@ -112,7 +119,7 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
                 cur.clone_from(best);
                 cur.begin();
                 for _ in 0..(n / 6).max(2) {
-                    if n <= REBUILD_UP_TO {
+                    if self.rebuild {
                         self.ruin_recreate(cur, rng, &mut ls);
                     } else {
                         self.kick(cur, rng, &mut ls);
@@ -130,7 +137,7 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
             // Kicks grow stronger while the search stagnates.
             let strength = 1 + (*stagnation / (4 * n as u64 + 50)).min(3) as usize;
             let mut kicked = false;
-            let rebuild = n <= REBUILD_UP_TO && rng.gen_bool(0.5);
+            let rebuild = self.rebuild && rng.gen_bool(0.5);
             for _ in 0..strength {
                 kicked |= if rebuild { self.ruin_recreate(cur, rng, &mut ls) } else { self.kick(cur, rng, &mut ls) };
             }
@@ -169,7 +176,7 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
     fn kick(&self, tour: &mut Tour, rng: &mut Pcg64Mcg, ls: &mut LocalSearch<'_, '_, C>) -> bool {
         let net = self.net;
         let n = tour.len();
-        let max_len = (n / 2).clamp(1, 50);
+        let max_len = (n / 2).clamp(1, KICK_SEGMENT);
         for _attempt in 0..20 {
             let l1 = rng.gen_range(1..=max_len);
             let l2 = rng.gen_range(1..=max_len);

@@ -17,6 +17,9 @@ const MAX_SEGMENT: usize = 3;
 /// Longest segments the segment exchange considers.
 const SWAP_WINDOW: usize = 64;
 
+/// Deepest chain of reversals in a Lin–Kernighan move.
+const LK_DEPTH: usize = 6;
+
 pub(crate) struct LocalSearch<'a, 'p, C> {
     net: &'a Net<'p, C>,
     nb: &'a Neighbors,
@@ -31,6 +34,8 @@ pub(crate) struct LocalSearch<'a, 'p, C> {
     pub deadline: Option<Instant>,
     /// Moves applied since creation (for statistics).
     pub moves: u64,
+    /// Endpoints of the arcs changed by the current Lin–Kernighan chain.
+    lk_touched: Vec<u32>,
 }
 
 /// An improving Or-opt move found by the scans.
@@ -56,6 +61,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             scan_limit: 5000,
             deadline: None,
             moves: 0,
+            lk_touched: Vec::new(),
         }
     }
 
@@ -121,13 +127,13 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             return true;
         }
         if v == self.net.anchor {
-            // The anchor never moves, but its arcs can still change through 2-opt.
-            return self.two_opt && self.try_two_opt(tour, v);
+            // The anchor never moves, but its arcs can still change through reversals.
+            return self.two_opt && self.try_lk(tour, v);
         }
-        if self.try_or_opt(tour, v) {
+        if self.two_opt && self.try_lk(tour, v) {
             return true;
         }
-        if self.two_opt && self.try_two_opt(tour, v) {
+        if self.try_or_opt(tour, v) {
             return true;
         }
         self.try_swap(tour, v)
@@ -141,6 +147,9 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         let n = tour.len();
         if n < 4 {
             return false;
+        }
+        if !net.has_prec {
+            return self.try_swap_candidates(tour, v);
         }
         let pv = tour.pos[v as usize] as usize;
         let w = SWAP_WINDOW.min(n);
@@ -199,6 +208,50 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                         self.apply_swap(tour, h, i, j, delta);
                         return true;
                     }
+                }
+            }
+        }
+        false
+    }
+
+    /// Segment exchange driven by candidate lists (no precedence): with h = prev(v), the new arc
+    /// h → i+1 goes to an out-neighbour of h and the new arc j → h+1 comes from an in-neighbour
+    /// of v, so only K² combinations are priced.
+    fn try_swap_candidates(&mut self, tour: &mut Tour, v: u32) -> bool {
+        let net = self.net;
+        let pv = tour.pos[v as usize] as usize;
+        if pv == 0 {
+            return false;
+        }
+        let h = pv - 1;
+        let hv = tour.seq[h];
+        let base_h = tour.arc(net, hv, v);
+        for &c in self.nb.out(hv) {
+            let pc = tour.pos[c as usize] as usize;
+            // c = seq[i+1] with i >= h+1
+            if pc <= h + 1 {
+                continue;
+            }
+            let g1 = base_h - tour.arc(net, hv, c);
+            if g1 <= self.eps && !net.multi_mode {
+                if net.p.cost_model().is_symmetric() {
+                    break;
+                }
+                continue;
+            }
+            let i = pc - 1;
+            let iv = tour.seq[i];
+            let g2 = g1 + tour.arc(net, iv, c);
+            for &d in self.nb.inn(v) {
+                let j = tour.pos[d as usize] as usize;
+                if j < pc {
+                    continue;
+                }
+                let q = tour.next_of_pos(j);
+                let delta = tour.arc(net, d, v) + tour.arc(net, iv, q) - tour.arc(net, d, q) - g2;
+                if delta < -self.eps && self.swap_cuts_ok(tour, h, i, j) {
+                    self.apply_swap(tour, h, i, j, delta);
+                    return true;
                 }
             }
         }
@@ -531,17 +584,33 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 pc - 1
             }
         };
+        // With one mode per task and symmetric costs, a new arc at least as long as the removal
+        // gain cannot pay off (positive-gain criterion); neighbour lists are sorted, so stop.
+        let prune = !net.multi_mode && net.p.cost_model().is_symmetric();
+        let too_long = |a: u32, b: u32| prune && tour.arc(net, a, b) >= gain;
         for &c in self.nb.inn(s) {
+            if too_long(c, s) {
+                break;
+            }
             consider(tour.pos[c as usize] as usize, false); // c -> s
         }
         for &c in self.nb.out(e) {
+            if too_long(e, c) {
+                break;
+            }
             consider(before(c), false); // e -> c
         }
         if rev_ok {
             for &c in self.nb.inn(e) {
+                if too_long(c, e) {
+                    break;
+                }
                 consider(tour.pos[c as usize] as usize, true); // c -> e
             }
             for &c in self.nb.out(s) {
+                if too_long(s, c) {
+                    break;
+                }
                 consider(before(c), true); // s -> c
             }
         }
@@ -557,74 +626,128 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         best
     }
 
-    /// 2-opt with neighbour lists (reversal-symmetric instances without precedence).
-    fn try_two_opt(&mut self, tour: &mut Tour, a: u32) -> bool {
+    /// A Lin–Kernighan move built from a chain of 2-opt reversals (reversal-symmetric instances
+    /// without precedence). From t1 and its tour neighbour t2, a step adds an arc t2–t3 to a
+    /// candidate t3, removes t3's arc to t4 (the neighbour that keeps a tour) and reverses the
+    /// stretch between, so the tour stays closed. At each level every candidate's closing is
+    /// priced exactly without touching the tour (that level is plain 2-opt); if none improves, the
+    /// step with the largest partial gain is applied tentatively and the chain goes on from t4
+    /// (depth up to `LK_DEPTH`); nothing improving means everything is undone.
+    fn try_lk(&mut self, tour: &mut Tour, t1: u32) -> bool {
         let net = self.net;
-        let n = tour.len();
-        if n < 4 {
+        if tour.len() < 5 {
             return false;
         }
-        let ma = tour.mode[a as usize];
-        for dir in [true, false] {
-            // dir: consider arc a->next(a); otherwise prev(a)->a.
-            let b = if dir { tour.next(a) } else { tour.prev(a) };
-            let ab = if dir { tour.arc(net, a, b) } else { tour.arc(net, b, a) };
-            for &c in self.nb.out(a) {
-                if c == b {
-                    continue;
-                }
-                let mc = tour.mode[c as usize];
-                let rc = net.rev_mode(c, mc);
-                // new arc between a and c (c reversed relative to its current direction)
-                let ac = if dir { net.arc(a, ma, c, rc) } else { net.arc(c, rc, a, ma) };
-                let g1 = ab - ac;
-                if g1 <= self.eps {
-                    if !net.multi_mode {
-                        break;
-                    }
-                    continue;
-                }
-                let d = if dir { tour.next(c) } else { tour.prev(c) };
-                if d == a {
-                    continue;
-                }
-                let (mb, md) = (tour.mode[b as usize], tour.mode[d as usize]);
-                let rb = net.rev_mode(b, mb);
-                let cd = if dir { tour.arc(net, c, d) } else { tour.arc(net, d, c) };
-                let bd = if dir { net.arc(b, rb, d, md) } else { net.arc(d, md, b, rb) };
-                let delta = bd - cd - g1;
-                if delta < -self.eps {
-                    // reverse the stretch between the two removed arcs that avoids position 0
-                    let (pa, pc) = (tour.pos[a as usize] as usize, tour.pos[c as usize] as usize);
-                    let (lo, hi) = if dir {
-                        // a b ... c d  or  c d ... a b
-                        if pa < pc {
-                            (pa + 1, pc)
-                        } else {
-                            (pc + 1, pa)
-                        }
-                    } else if pa < pc {
-                        // b a ... d c -> reverse a..d
-                        (pa, pc - 1)
-                    } else {
-                        // d c ... b a -> reverse c..b
-                        (pc, pa - 1)
-                    };
-                    // the complement stretch gives the same arcs when this one holds position 0
-                    let (lo, hi) = if lo == 0 { (hi + 1, n - 1) } else { (lo, hi) };
-                    if lo == 0 || lo > hi || hi >= n || !net.move_allowed(&tour.seq, &[(a, b), (c, d)], lo, hi) {
+        let own_journal = !tour.journaling();
+        if own_journal {
+            tour.begin();
+        }
+        let mut improved = false;
+        'dirs: for first_forward in [true, false] {
+            let start = tour.mark();
+            let mut t2 = if first_forward { tour.next(t1) } else { tour.prev(t1) };
+            let mut g = if first_forward { tour.arc(net, t1, t2) } else { tour.arc(net, t2, t1) };
+            let mut so_far = 0.0;
+            self.lk_touched.clear();
+            self.lk_touched.push(t1);
+            self.lk_touched.push(t2);
+            for depth in 1..=LK_DEPTH {
+                let forward = tour.next(t1) == t2;
+                let mut close: Option<(usize, usize, Cost, u32, u32)> = None;
+                let mut close_total = -self.eps;
+                let mut deeper: Option<(usize, usize, Cost, u32, u32, Cost)> = None;
+                for &t3 in self.nb.out(t2) {
+                    if t3 == t1 || (depth > 1 && self.lk_touched.contains(&t3)) {
                         continue;
                     }
+                    let g1 = g - if forward { tour.arc(net, t2, t3) } else { tour.arc(net, t3, t2) };
+                    if g1 <= self.eps {
+                        if net.multi_mode {
+                            continue;
+                        }
+                        break;
+                    }
+                    let t4 = if forward { tour.prev(t3) } else { tour.next(t3) };
+                    if t4 == t2 || t4 == t1 {
+                        continue;
+                    }
+                    // removed arcs in array order: (a, next a) and (b, next b)
+                    let a = if forward { t1 } else { t2 };
+                    let b = if forward { t4 } else { t3 };
+                    let (pa, pb) = (tour.pos[a as usize] as usize, tour.pos[b as usize] as usize);
+                    let (lo, hi) = if pa < pb { (pa + 1, pb) } else { (pb + 1, pa) };
+                    if net.has_groups && !net.move_allowed(&tour.seq, &[(a, tour.next(a)), (b, tour.next(b))], lo, hi) {
+                        continue;
+                    }
+                    let g2 = g1 + if forward { tour.arc(net, t4, t3) } else { tour.arc(net, t3, t4) };
+                    // cost change of the tour closed by t4–t1: exact, or from the gains when every
+                    // arc costs the same both ways
+                    let total = if net.plain_symmetric {
+                        tour.arc(net, t4, t1) - g2
+                    } else {
+                        so_far + self.reversal_delta(tour, lo, hi)
+                    };
+                    let step = total - so_far;
+                    if total < close_total {
+                        close_total = total;
+                        close = Some((lo, hi, step, t3, t4));
+                    }
+                    if deeper.is_none_or(|d| g2 > d.5) {
+                        deeper = Some((lo, hi, step, t3, t4, g2));
+                    }
+                }
+                if let Some((lo, hi, step, t3, t4)) = close {
                     tour.reverse(lo, hi);
                     tour.reverse_modes(net, lo, hi);
-                    tour.cost += delta;
-                    for x in [a, b, c, d] {
-                        self.push(x);
-                    }
-                    return true;
+                    tour.cost += step;
+                    self.lk_touched.push(t3);
+                    self.lk_touched.push(t4);
+                    improved = true;
+                    break 'dirs;
                 }
+                let Some((lo, hi, step, t3, t4, g2)) = deeper else { break };
+                if depth == LK_DEPTH {
+                    break;
+                }
+                tour.reverse(lo, hi);
+                tour.reverse_modes(net, lo, hi);
+                tour.cost += step;
+                so_far += step;
+                self.lk_touched.push(t3);
+                self.lk_touched.push(t4);
+                t2 = t4;
+                g = g2;
             }
+            tour.undo_to(start);
         }
-        false
+        if improved {
+            let touched = std::mem::take(&mut self.lk_touched);
+            for &x in &touched {
+                self.push(x);
+            }
+            self.lk_touched = touched;
+        }
+        if own_journal {
+            tour.commit();
+        }
+        improved
+    }
+
+    /// Exact cost change of reversing positions `lo..=hi` (modes swapped to their reverses;
+    /// the inside keeps its cost because the instance is reversal-symmetric).
+    fn reversal_delta(&self, tour: &Tour, lo: usize, hi: usize) -> Cost {
+        let net = self.net;
+        let p = tour.seq[lo - 1];
+        let l = tour.seq[lo];
+        let h = tour.seq[hi];
+        let q = tour.next_of_pos(hi);
+        let (mp, ml, mh, mq) =
+            (tour.mode[p as usize], tour.mode[l as usize], tour.mode[h as usize], tour.mode[q as usize]);
+        let (rl, rh) = (net.rev_mode(l, ml), net.rev_mode(h, mh));
+        if lo == hi {
+            // a single node turned round
+            return net.arc(p, mp, l, rl) + net.arc(l, rl, q, mq) - net.arc(p, mp, l, ml) - net.arc(l, ml, q, mq);
+        }
+        net.arc(p, mp, h, rh) + net.arc(l, rl, q, mq) - net.arc(p, mp, l, ml) - net.arc(h, mh, q, mq)
     }
 }

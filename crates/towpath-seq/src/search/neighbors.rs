@@ -1,8 +1,8 @@
 //! Candidate neighbour lists: for each task, the few tasks it is cheapest to go to (out) and to
-//! come from (in). Built from a k-d tree when the cost model has positions, else by scanning.
+//! come from (in). Built from an R-tree when the cost model has positions, else by scanning.
 
-use kiddo::immutable::float::kdtree::ImmutableKdTree;
-use kiddo::SquaredEuclidean;
+use rstar::primitives::GeomWithData;
+use rstar::RTree;
 
 use super::net::Net;
 use crate::cost::{Cost, CostModel, StateId};
@@ -11,7 +11,9 @@ use crate::model::TaskId;
 pub(crate) struct Neighbors {
     k: usize,
     out: Vec<u32>,
+    out_len: Vec<u8>,
     inn: Vec<u32>,
+    inn_len: Vec<u8>,
     symmetric: bool,
 }
 
@@ -19,11 +21,13 @@ impl Neighbors {
     /// Tasks cheapest to go to from `v` (best first). Empty for the depot.
     #[inline]
     pub fn out(&self, v: u32) -> &[u32] {
-        let a = v as usize * self.k;
-        if a >= self.out.len() {
-            return &[];
+        match self.out_len.get(v as usize) {
+            Some(&l) => {
+                let a = v as usize * self.k;
+                &self.out[a..a + l as usize]
+            }
+            None => &[],
         }
-        trim(&self.out[a..a + self.k])
     }
 
     /// Tasks cheapest to come from into `v` (best first).
@@ -32,11 +36,13 @@ impl Neighbors {
         if self.symmetric {
             return self.out(v);
         }
-        let a = v as usize * self.k;
-        if a >= self.inn.len() {
-            return &[];
+        match self.inn_len.get(v as usize) {
+            Some(&l) => {
+                let a = v as usize * self.k;
+                &self.inn[a..a + l as usize]
+            }
+            None => &[],
         }
-        trim(&self.inn[a..a + self.k])
     }
 
     pub fn build<C: CostModel>(net: &Net<C>, k: usize) -> Self {
@@ -72,13 +78,14 @@ impl Neighbors {
                 fill(&mut inn[v as usize * k..(v as usize + 1) * k], &mut scored);
             }
         }
-        Neighbors { k, out, inn, symmetric }
+        let out_len = (0..n).map(|v| count(&out[v * k..(v + 1) * k])).collect();
+        let inn_len = if symmetric { Vec::new() } else { (0..n).map(|v| count(&inn[v * k..(v + 1) * k])).collect() };
+        Neighbors { k, out, out_len, inn, inn_len, symmetric }
     }
 }
 
-fn trim(s: &[u32]) -> &[u32] {
-    let end = s.iter().position(|&x| x == u32::MAX).unwrap_or(s.len());
-    &s[..end]
+fn count(s: &[u32]) -> u8 {
+    s.iter().position(|&x| x == u32::MAX).unwrap_or(s.len()) as u8
 }
 
 fn fill(dst: &mut [u32], scored: &mut [(Cost, u32)]) {
@@ -143,7 +150,8 @@ fn spatial_points<C: CostModel>(net: &Net<C>) -> Option<(Vec<[f64; 3]>, Vec<u32>
 }
 
 fn kd_candidates<C: CostModel>(net: &Net<C>, pts: &[[f64; 3]], owner: &[u32], k: usize) -> Vec<Vec<u32>> {
-    let tree: ImmutableKdTree<f64, u32, 3, 32> = ImmutableKdTree::new_from_slice(pts);
+    let tree: RTree<GeomWithData<[f64; 3], u32>> =
+        RTree::bulk_load(pts.iter().zip(owner).map(|(p, &t)| GeomWithData::new(*p, t)).collect());
     let n = net.n_tasks;
     let mut by_task: Vec<Vec<usize>> = vec![Vec::new(); n];
     for (i, &t) in owner.iter().enumerate() {
@@ -157,8 +165,8 @@ fn kd_candidates<C: CostModel>(net: &Net<C>, pts: &[[f64; 3]], owner: &[u32], k:
         let per_point = (2 * k + 1) * idxs.len().max(1) + 4;
         let mut cands: Vec<u32> = Vec::new();
         for &i in idxs {
-            for nn in tree.nearest_n::<SquaredEuclidean>(&pts[i], per_point.min(pts.len())) {
-                let u = owner[nn.item as usize];
+            for nn in tree.nearest_neighbor_iter(&pts[i]).take(per_point) {
+                let u = nn.data;
                 if mark[u as usize] != t as u32 {
                     mark[u as usize] = t as u32;
                     cands.push(u);

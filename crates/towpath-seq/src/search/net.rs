@@ -6,7 +6,7 @@
 //! become precedence edges, so every move that keeps precedence keeps them too.
 
 use crate::cost::{Cost, CostModel, StateId};
-use crate::model::{End, Problem, TaskId, NO_GROUP};
+use crate::model::{End, Problem, NO_GROUP};
 
 /// Marks "no reverse mode".
 pub(crate) const NO_REV: u32 = u32::MAX;
@@ -26,10 +26,19 @@ pub(crate) struct Net<'p, C> {
     /// Reverse mode of each (task, mode), indexed by the global mode index.
     rev: Vec<u32>,
     mode_base: Vec<u32>,
+    /// Entry and exit state and cost of each (task, mode), by global mode index.
+    entry: Vec<StateId>,
+    exit: Vec<StateId>,
+    mcost: Vec<Cost>,
+    /// Every mode begins and ends in the same state: reversing changes no mode.
+    pub modes_self_reverse: bool,
     /// Every mode of every task has a reverse mode of equal cost, and the cost model is
     /// symmetric: reversing a stretch of the tour (with modes swapped) leaves its inside cost
     /// unchanged.
     pub reversal_symmetric: bool,
+    /// Reversal-symmetric, modes self-reverse and the depot (if any) priced the same both ways:
+    /// every arc costs the same in both directions.
+    pub plain_symmetric: bool,
     /// Precedence including pins, in compressed form.
     succ_off: Vec<u32>,
     succ: Vec<u32>,
@@ -63,10 +72,16 @@ impl<'p, C: CostModel> Net<'p, C> {
         let mut mode_base = Vec::with_capacity(n_tasks + 1);
         let mut rev = Vec::new();
         let mut all_rev = true;
+        let (mut entry, mut exit, mut mcost) = (Vec::new(), Vec::new(), Vec::new());
+        let mut modes_self_reverse = true;
         for t in p.tasks() {
             mode_base.push(rev.len() as u32);
             let ms = p.modes(t);
             for m in ms {
+                entry.push(m.entry);
+                exit.push(m.exit);
+                mcost.push(m.cost);
+                modes_self_reverse &= m.entry == m.exit;
                 let r = ms
                     .iter()
                     .position(|o| o.entry == m.exit && o.exit == m.entry && o.cost == m.cost)
@@ -77,6 +92,8 @@ impl<'p, C: CostModel> Net<'p, C> {
         }
         mode_base.push(rev.len() as u32);
         let reversal_symmetric = all_rev && p.cost_model().is_symmetric();
+        let depot_symmetric = cyclic || p.start() == back;
+        let plain_symmetric = reversal_symmetric && modes_self_reverse && depot_symmetric;
 
         // Precedence with pins.
         let mut edges: Vec<(u32, u32)> = Vec::new();
@@ -115,7 +132,12 @@ impl<'p, C: CostModel> Net<'p, C> {
             back,
             rev,
             mode_base,
+            entry,
+            exit,
+            mcost,
+            modes_self_reverse,
             reversal_symmetric,
+            plain_symmetric,
             succ_off,
             succ,
             pred_off,
@@ -144,7 +166,7 @@ impl<'p, C: CostModel> Net<'p, C> {
         if v == self.depot {
             0.0
         } else {
-            self.p.modes(TaskId(v))[m as usize].cost
+            self.mcost[(self.mode_base[v as usize] + m) as usize]
         }
     }
 
@@ -159,16 +181,19 @@ impl<'p, C: CostModel> Net<'p, C> {
                 };
             }
             match self.p.start() {
-                Some(s) => self.p.transition(s, self.p.modes(TaskId(b))[mb as usize].entry),
+                Some(s) => self.p.transition(s, self.entry[(self.mode_base[b as usize] + mb) as usize]),
                 None => 0.0,
             }
         } else if b == self.depot {
             match self.back {
-                Some(e) => self.p.transition(self.p.modes(TaskId(a))[ma as usize].exit, e),
+                Some(e) => self.p.transition(self.exit[(self.mode_base[a as usize] + ma) as usize], e),
                 None => 0.0,
             }
         } else {
-            self.p.transition(self.p.modes(TaskId(a))[ma as usize].exit, self.p.modes(TaskId(b))[mb as usize].entry)
+            self.p.transition(
+                self.exit[(self.mode_base[a as usize] + ma) as usize],
+                self.entry[(self.mode_base[b as usize] + mb) as usize],
+            )
         }
     }
 

@@ -124,6 +124,38 @@ impl Tour {
         self.journaling = false;
     }
 
+    /// True while changes are being recorded.
+    pub fn journaling(&self) -> bool {
+        self.journaling
+    }
+
+    /// A point in the journal to come back to with [`Tour::undo_to`] (journaling must be on).
+    pub fn mark(&mut self) -> usize {
+        debug_assert!(self.journaling);
+        let m = self.journal.len();
+        self.journal.push(Entry::Cost(self.cost));
+        m
+    }
+
+    /// Undoes every change recorded after `mark` (the journal stays on).
+    pub fn undo_to(&mut self, mark: usize) {
+        while self.journal.len() > mark {
+            match self.journal.pop() {
+                Some(Entry::Range { lo, len, at }) => {
+                    let (lo, len, at) = (lo as usize, len as usize, at as usize);
+                    self.seq[lo..lo + len].copy_from_slice(&self.saved[at..at + len]);
+                    for i in lo..lo + len {
+                        self.pos[self.seq[i] as usize] = i as u32;
+                    }
+                    self.saved.truncate(at);
+                }
+                Some(Entry::Mode { node, old }) => self.mode[node as usize] = old,
+                Some(Entry::Cost(c)) => self.cost = c,
+                None => break,
+            }
+        }
+    }
+
     fn save_range(&mut self, lo: usize, hi: usize) {
         if self.journaling {
             let at = self.saved.len() as u32;
@@ -187,6 +219,9 @@ impl Tour {
 
     /// Switches every node at positions `i..=j` to its reverse mode (which must exist).
     pub fn reverse_modes<C: CostModel>(&mut self, net: &Net<C>, i: usize, j: usize) {
+        if net.modes_self_reverse {
+            return;
+        }
         for p in i..=j {
             let v = self.seq[p];
             let r = net.rev_mode(v, self.mode[v as usize]);

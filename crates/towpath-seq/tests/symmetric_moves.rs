@@ -1,0 +1,65 @@
+//! Reversal moves (2-opt / Lin–Kernighan chains) on symmetric instances: plain TSP, point modes
+//! (GTSP-like) and reversible two-mode tasks, closed and open. The solver's answer must be
+//! feasible, its checked cost must match, and it must be a decent tour (within a few percent of
+//! a long run).
+
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+use towpath_seq::*;
+
+fn points(n: usize, seed: u64) -> Vec<[f64; 3]> {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    (0..n).map(|_| [rng.gen_range(0.0..1000.0), rng.gen_range(0.0..1000.0), 0.0]).collect()
+}
+
+fn run<C: CostModel>(p: &Problem<C>, iterations: u64) -> f64 {
+    let opts = SolveOptions {
+        time_limit: None,
+        iterations: Some(iterations),
+        threads: 1,
+        exact_up_to: 0,
+        ..Default::default()
+    };
+    let r = solve(p, &opts).unwrap();
+    let c = check(p, &r.solution.steps).unwrap();
+    assert!((c - r.solution.cost).abs() < 1e-6);
+    c
+}
+
+#[test]
+fn tsp_closed() {
+    let pts = points(300, 1);
+    let mut b = Problem::builder(PointCost::new(pts, Metric::Euclidean));
+    b.point_tasks(300);
+    let p = b.build().unwrap();
+    let short = run(&p, 200);
+    let long = run(&p, 3000);
+    assert!(long <= short + 1e-6);
+    // random uniform 300 points in a 1000x1000 square: optimum is about 0.7124*sqrt(n*A) ~ 12.3k
+    assert!(short < 13_500.0, "{short}");
+}
+
+#[test]
+fn reversible_strokes_open() {
+    let pts = points(400, 2);
+    let mut b = Problem::builder(PointCost::new(pts, Metric::Euclidean));
+    for k in 0..200u32 {
+        let (s, e) = (StateId(2 * k), StateId(2 * k + 1));
+        b.task(vec![Mode::new(s, e), Mode::new(e, s)]);
+    }
+    b.end(End::Free);
+    let p = b.build().unwrap();
+    run(&p, 300);
+}
+
+#[test]
+fn point_modes_from_start() {
+    let pts = points(301, 3);
+    let mut b = Problem::builder(PointCost::new(pts, Metric::EuclideanNint));
+    for k in 0..100u32 {
+        b.task((0..3).map(|j| Mode::point(StateId(3 * k + j))).collect());
+    }
+    b.start(StateId(300));
+    let p = b.build().unwrap();
+    run(&p, 300);
+}
