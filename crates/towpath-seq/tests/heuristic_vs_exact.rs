@@ -16,12 +16,23 @@ fn random_case(seed: u64) -> Option<Case> {
     let mut rng = Pcg64Mcg::seed_from_u64(seed);
     let n = rng.gen_range(3..=11usize);
     let max_modes = rng.gen_range(1..=4usize);
+    // a third of the instances are bidirectional: every mode has its reverse, costs symmetric
+    let bidirectional = rng.gen_bool(0.33);
     // states: per task up to 2 per mode, plus 2 route-end states
     let mut pts: Vec<(f64, f64)> = Vec::new();
     let mut task_modes: Vec<Vec<(u32, u32)>> = Vec::new();
     for _ in 0..n {
         let m = rng.gen_range(1..=max_modes);
         let mut ms = Vec::new();
+        if bidirectional {
+            let a = pts.len() as u32;
+            pts.push((rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0)));
+            pts.push((rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0)));
+            ms.push((a, a + 1));
+            ms.push((a + 1, a));
+            task_modes.push(ms);
+            continue;
+        }
         for _ in 0..m {
             let a = pts.len() as u32;
             pts.push((rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0)));
@@ -39,7 +50,7 @@ fn random_case(seed: u64) -> Option<Case> {
     pts.push((rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0)));
     let end_state = pts.len() as u32;
     pts.push((rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0)));
-    let asym = rng.gen_bool(0.5);
+    let asym = !bidirectional && rng.gen_bool(0.5);
     let ns = pts.len();
     let skew: Vec<f64> = (0..ns * ns).map(|_| if asym { rng.gen_range(0.0..30.0) } else { 0.0 }).collect();
     let m = MatrixCost::from_fn(ns, |i, j| {
@@ -56,7 +67,7 @@ fn random_case(seed: u64) -> Option<Case> {
         b.task(modes);
     }
     let route = rng.gen_range(0..5);
-    let mut label = format!("seed {seed} n {n} modes<= {max_modes} asym {asym} ");
+    let mut label = format!("seed {seed} n {n} modes<= {max_modes} asym {asym} bidir {bidirectional} ");
     match route {
         0 => label += "cycle",
         1 => {

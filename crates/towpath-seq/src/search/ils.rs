@@ -236,7 +236,9 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         if k == 0 {
             return false;
         }
-        let free = |v: u32| v != net.anchor && (!net.has_groups || net.group(v) == crate::model::NO_GROUP);
+        let free = |v: u32| {
+            tour.pos[v as usize] != 0 && v != net.depot && (!net.has_groups || net.group(v) == crate::model::NO_GROUP)
+        };
         let v = tour.seq[rng.gen_range(1..n)];
         if !free(v) {
             return false;

@@ -14,6 +14,9 @@ use crate::cost::{Cost, CostModel};
 /// Longest segment Or-opt moves.
 const MAX_SEGMENT: usize = 3;
 
+/// With precedence, Or-opt scans every position up to this size and uses candidate lists above.
+const SCAN_UP_TO: usize = 0;
+
 /// Longest segments the segment exchange considers.
 const SWAP_WINDOW: usize = 64;
 
@@ -36,6 +39,9 @@ pub(crate) struct LocalSearch<'a, 'p, C> {
     pub moves: u64,
     /// Endpoints of the arcs changed by the current Lin–Kernighan chain.
     lk_touched: Vec<u32>,
+    /// Scratch heaps for the segment exchange's precedence checks.
+    heap: std::collections::BinaryHeap<std::cmp::Reverse<u32>>,
+    heap_max: std::collections::BinaryHeap<u32>,
 }
 
 /// An improving Or-opt move found by the scans.
@@ -62,6 +68,8 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             deadline: None,
             moves: 0,
             lk_touched: Vec::new(),
+            heap: std::collections::BinaryHeap::new(),
+            heap_max: std::collections::BinaryHeap::new(),
         }
     }
 
@@ -126,8 +134,8 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         if self.net.multi_mode && self.try_mode(tour, v) {
             return true;
         }
-        if v == self.net.anchor {
-            // The anchor never moves, but its arcs can still change through reversals.
+        if tour.pos[v as usize] == 0 {
+            // Position 0 never moves, but its arcs can still change through reversals.
             return self.two_opt && self.try_lk(tour, v);
         }
         if self.two_opt && self.try_lk(tour, v) {
@@ -140,118 +148,130 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
     }
 
     /// Path-preserving 3-opt ("segment exchange", the SOP-3-exchange of Gambardella and Dorigo):
-    /// swaps two adjacent segments of any length up to `SWAP_WINDOW`, one of them starting or
-    /// ending at `v`. Precedence is checked incrementally with marks while the segments grow.
+    /// swaps two adjacent segments L = h+1..=i and R = i+1..=j, one of them starting or ending
+    /// at `v`. Candidate lists pick the new arcs, so only K² exchanges are priced; with
+    /// precedence, segments are at most `SWAP_WINDOW` long and a heap of the successor
+    /// (predecessor) positions of the growing segment tells in O(log) whether an exchange keeps
+    /// precedence.
     fn try_swap(&mut self, tour: &mut Tour, v: u32) -> bool {
         let net = self.net;
         let n = tour.len();
         if n < 4 {
             return false;
         }
-        if !net.has_prec {
-            return self.try_swap_candidates(tour, v);
-        }
         let pv = tour.pos[v as usize] as usize;
-        let w = SWAP_WINDOW.min(n);
-        let arc = |t: &Tour, a: usize, b: usize| t.arc(net, t.seq[a], t.seq[b % n]);
-        // Forward: h = pv - 1, L = [h+1..=i] starts at v, R = [i+1..=j].
+        let window = if net.has_prec { SWAP_WINDOW } else { n };
+        let prune = !net.multi_mode && net.p.cost_model().is_symmetric();
+        // Forward: h = pv - 1, L starts at v, the new arc h -> i+1 goes to a neighbour of seq[h].
         if pv >= 1 {
             let h = pv - 1;
-            self.stamp += 1;
-            let st = self.stamp;
-            let base_h = arc(tour, h, h + 1);
-            for i in h + 1..(h + 1 + w).min(n - 1) {
-                for &x in net.successors(tour.seq[i]) {
-                    self.mark[x as usize] = st;
-                }
-                let base_hi = base_h + arc(tour, i, i + 1);
-                let g1 = base_hi - arc(tour, h, i + 1);
-                for j in i + 1..(i + 1 + w).min(n) {
-                    if self.mark[tour.seq[j] as usize] == st {
-                        break;
-                    }
-                    let delta = arc(tour, j, h + 1) + arc(tour, i, j + 1) - arc(tour, j, j + 1) - g1;
-                    if delta < -self.eps && self.swap_cuts_ok(tour, h, i, j) {
-                        self.apply_swap(tour, h, i, j, delta);
-                        return true;
-                    }
-                }
-            }
-        }
-        // Backward: j = pv, R = [i+1..=j] ends at v, L = [h+1..=i].
-        {
-            let j = pv;
-            if j < 2 {
-                return false;
-            }
-            self.stamp += 1;
-            let st = self.stamp;
-            let base_j = arc(tour, j, j + 1);
-            let lo_i = j.saturating_sub(w).max(1);
-            let mut i = j;
-            while i > lo_i {
-                i -= 1;
-                for &x in net.predecessors(tour.seq[i + 1]) {
-                    self.mark[x as usize] = st;
-                }
-                let base_ij = base_j + arc(tour, i, i + 1);
-                let lo_h = i.saturating_sub(w);
-                let mut h = i;
-                while h > lo_h {
-                    h -= 1;
-                    if self.mark[tour.seq[h + 1] as usize] == st {
-                        break;
-                    }
-                    let delta =
-                        arc(tour, h, i + 1) + arc(tour, j, h + 1) + arc(tour, i, j + 1) - arc(tour, h, h + 1) - base_ij;
-                    if delta < -self.eps && self.swap_cuts_ok(tour, h, i, j) {
-                        self.apply_swap(tour, h, i, j, delta);
-                        return true;
-                    }
-                }
-            }
-        }
-        false
-    }
-
-    /// Segment exchange driven by candidate lists (no precedence): with h = prev(v), the new arc
-    /// h → i+1 goes to an out-neighbour of h and the new arc j → h+1 comes from an in-neighbour
-    /// of v, so only K² combinations are priced.
-    fn try_swap_candidates(&mut self, tour: &mut Tour, v: u32) -> bool {
-        let net = self.net;
-        let pv = tour.pos[v as usize] as usize;
-        if pv == 0 {
-            return false;
-        }
-        let h = pv - 1;
-        let hv = tour.seq[h];
-        let base_h = tour.arc(net, hv, v);
-        for &c in self.nb.out(hv) {
-            let pc = tour.pos[c as usize] as usize;
-            // c = seq[i+1] with i >= h+1
-            if pc <= h + 1 {
-                continue;
-            }
-            let g1 = base_h - tour.arc(net, hv, c);
-            if g1 <= self.eps && !net.multi_mode {
-                if net.p.cost_model().is_symmetric() {
-                    break;
-                }
-                continue;
-            }
-            let i = pc - 1;
-            let iv = tour.seq[i];
-            let g2 = g1 + tour.arc(net, iv, c);
-            for &d in self.nb.inn(v) {
-                let j = tour.pos[d as usize] as usize;
-                if j < pc {
+            let hv = tour.seq[h];
+            let base_h = tour.arc(net, hv, v);
+            let mut cands: Vec<(usize, u32)> = self
+                .nb
+                .out(hv)
+                .iter()
+                .map(|&c| (tour.pos[c as usize] as usize, c))
+                .filter(|&(pc, _)| pc > h + 1 && pc - h - 1 <= window)
+                .collect();
+            cands.sort_unstable();
+            self.heap.clear();
+            let mut ext = h; // L = h+1..=ext has been scanned for successors
+            for (pc, c) in cands {
+                let i = pc - 1;
+                let g1 = base_h - tour.arc(net, hv, c);
+                if g1 <= self.eps && prune {
                     continue;
                 }
-                let q = tour.next_of_pos(j);
-                let delta = tour.arc(net, d, v) + tour.arc(net, iv, q) - tour.arc(net, d, q) - g2;
-                if delta < -self.eps && self.swap_cuts_ok(tour, h, i, j) {
-                    self.apply_swap(tour, h, i, j, delta);
-                    return true;
+                // first successor of L to the right of it: R must end before it
+                let mut bound = n;
+                if net.has_prec {
+                    while ext < i {
+                        ext += 1;
+                        for &x in net.successors(tour.seq[ext]) {
+                            self.heap.push(std::cmp::Reverse(tour.pos[x as usize]));
+                        }
+                    }
+                    while let Some(&std::cmp::Reverse(top)) = self.heap.peek() {
+                        if (top as usize) <= i {
+                            self.heap.pop();
+                        } else {
+                            bound = top as usize;
+                            break;
+                        }
+                    }
+                }
+                let iv = tour.seq[i];
+                let g2 = g1 + tour.arc(net, iv, c);
+                for &d in self.nb.inn(v) {
+                    let j = tour.pos[d as usize] as usize;
+                    if j < pc || j >= bound {
+                        continue;
+                    }
+                    let q = tour.next_of_pos(j);
+                    let delta = tour.arc(net, d, v) + tour.arc(net, iv, q) - tour.arc(net, d, q) - g2;
+                    if delta < -self.eps && self.swap_cuts_ok(tour, h, i, j) {
+                        self.apply_swap(tour, h, i, j, delta);
+                        return true;
+                    }
+                }
+            }
+        }
+        // Backward: j = pv, R ends at v, the new arc i -> j+1 comes from a neighbour of seq[j+1].
+        if pv >= 2 {
+            let j = pv;
+            let q = tour.next_of_pos(j);
+            let base_j = tour.arc(net, v, q);
+            let mut cands: Vec<(usize, u32)> = self
+                .nb
+                .inn(q)
+                .iter()
+                .map(|&u| (tour.pos[u as usize] as usize, u))
+                .filter(|&(pu, _)| pu >= 1 && pu < j && j - pu <= window)
+                .collect();
+            cands.sort_unstable_by(|a, b| b.cmp(a));
+            self.heap_max.clear();
+            let mut ext = j + 1; // R = ext..=j has been scanned for predecessors
+            for (i, iv) in cands {
+                let c = tour.seq[i + 1];
+                let g1 = base_j + tour.arc(net, iv, c) - tour.arc(net, iv, q);
+                if g1 <= self.eps && prune {
+                    continue;
+                }
+                // last predecessor of R to the left of it: L must start after it
+                let mut floor = 0usize;
+                if net.has_prec {
+                    while ext > i + 1 {
+                        ext -= 1;
+                        for &x in net.predecessors(tour.seq[ext]) {
+                            self.heap_max.push(tour.pos[x as usize]);
+                        }
+                    }
+                    while let Some(&top) = self.heap_max.peek() {
+                        if (top as usize) > i {
+                            self.heap_max.pop();
+                        } else {
+                            floor = top as usize;
+                            break;
+                        }
+                    }
+                }
+                for &w in self.nb.out(v) {
+                    // w = seq[h+1], the new arc j -> h+1
+                    let pw = tour.pos[w as usize] as usize;
+                    if pw == 0 || pw > i {
+                        continue;
+                    }
+                    let h = pw - 1;
+                    if h < floor {
+                        continue;
+                    }
+                    let hv = tour.seq[h];
+                    let delta = tour.arc(net, v, w) + tour.arc(net, hv, c) - tour.arc(net, hv, w) - g1;
+                    if delta < -self.eps && self.swap_cuts_ok(tour, h, i, j) {
+                        self.apply_swap(tour, h, i, j, delta);
+                        return true;
+                    }
                 }
             }
         }
@@ -376,7 +396,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         } else {
             0.0
         };
-        let best = if net.has_prec {
+        let best = if net.has_prec && tour.len() <= SCAN_UP_TO {
             self.scan_insertions(tour, i, j, gain, rev_ok, rev_inside)
         } else {
             self.candidate_insertions(tour, i, j, gain, rev_ok, rev_inside)
@@ -542,7 +562,30 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         best
     }
 
-    /// Or-opt over candidate neighbours (no precedence).
+    /// Where the segment at `i..=j` may go: after a position in `lo..hi`, where `lo` is the
+    /// position of its last predecessor outside it and `hi` that of its first successor.
+    fn precedence_window(&self, tour: &Tour, i: usize, j: usize) -> (usize, usize) {
+        let net = self.net;
+        let (mut lo, mut hi) = (0usize, tour.len());
+        for t in i..=j {
+            let v = tour.seq[t];
+            for &x in net.predecessors(v) {
+                let px = tour.pos[x as usize] as usize;
+                if px < i && px > lo {
+                    lo = px;
+                }
+            }
+            for &x in net.successors(v) {
+                let px = tour.pos[x as usize] as usize;
+                if px > j && px < hi {
+                    hi = px;
+                }
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Or-opt over candidate neighbours, precedence checked against the segment's window.
     fn candidate_insertions(
         &mut self,
         tour: &Tour,
@@ -557,8 +600,10 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         let (s, e) = (tour.seq[i], tour.seq[j]);
         let mut best: Option<Insertion> = None;
         let mut best_delta = -self.eps;
-        // k: insert after position k; valid if k < i - 1 or k > j
-        let valid = |k: usize| k + 1 < i || k > j;
+        // k: insert after position k; valid if k < i - 1 or k > j, and with precedence only
+        // between the segment's last predecessor and first successor
+        let (lo_k, hi_k) = if net.has_prec { self.precedence_window(tour, i, j) } else { (0, n) };
+        let valid = |k: usize| (k + 1 < i && k >= lo_k) || (k > j && k < hi_k);
         let (p, q) = (tour.seq[i - 1], tour.next_of_pos(j));
         let mut consider = |k: usize, reversed: bool| {
             if !valid(k) || (reversed && !rev_ok) {
@@ -614,13 +659,15 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 consider(before(c), true); // s -> c
             }
         }
-        if net.depot != u32::MAX || (s == e && net.multi_mode) {
+        if net.depot != u32::MAX {
             // next to the depot: start or end of an open route
-            consider(0, false);
-            consider(n - 1, false);
+            let pd = tour.pos[net.depot as usize] as usize;
+            let before_depot = if pd == 0 { n - 1 } else { pd - 1 };
+            consider(pd, false);
+            consider(before_depot, false);
             if rev_ok {
-                consider(0, true);
-                consider(n - 1, true);
+                consider(pd, true);
+                consider(before_depot, true);
             }
         }
         best
@@ -697,8 +744,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                     }
                 }
                 if let Some((lo, hi, step, t3, t4)) = close {
-                    tour.reverse(lo, hi);
-                    tour.reverse_modes(net, lo, hi);
+                    self.reverse_short_way(tour, lo, hi);
                     tour.cost += step;
                     self.lk_touched.push(t3);
                     self.lk_touched.push(t4);
@@ -709,8 +755,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 if depth == LK_DEPTH {
                     break;
                 }
-                tour.reverse(lo, hi);
-                tour.reverse_modes(net, lo, hi);
+                self.reverse_short_way(tour, lo, hi);
                 tour.cost += step;
                 so_far += step;
                 self.lk_touched.push(t3);
@@ -731,6 +776,25 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             tour.commit();
         }
         improved
+    }
+
+    /// Reverses positions `lo..=hi`, or the rest of the cycle when that is shorter and allowed
+    /// (the same tour, read the other way), then turns the modes round.
+    fn reverse_short_way(&self, tour: &mut Tour, lo: usize, hi: usize) {
+        let n = tour.len();
+        if self.net.wrap_ok && 2 * (hi - lo + 1) > n {
+            let (a, b) = ((hi + 1) % n, lo - 1);
+            tour.reverse_cyclic(a, b);
+            if a <= b {
+                tour.reverse_modes(self.net, a, b);
+            } else {
+                tour.reverse_modes(self.net, a, n - 1);
+                tour.reverse_modes(self.net, 0, b);
+            }
+        } else {
+            tour.reverse(lo, hi);
+            tour.reverse_modes(self.net, lo, hi);
+        }
     }
 
     /// Exact cost change of reversing positions `lo..=hi` (modes swapped to their reverses;

@@ -272,6 +272,8 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
 }
 
 fn optimize_final<C: CostModel>(net: &Net<C>, tour: &mut Tour, eps: Cost) {
+    // wrapped reversals may have moved the anchor off position 0
+    tour.rotate_to(net.anchor);
     modes::optimize_modes(net, tour, eps);
     tour.cost = tour.full_cost(net);
 }

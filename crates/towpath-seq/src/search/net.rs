@@ -39,6 +39,10 @@ pub(crate) struct Net<'p, C> {
     /// Reversal-symmetric, modes self-reverse and the depot (if any) priced the same both ways:
     /// every arc costs the same in both directions.
     pub plain_symmetric: bool,
+    /// Long reversals may go the short way round through position 0 (reversal-symmetric with a
+    /// depot priced the same both ways, no precedence, no groups): who sits at position 0 may then change, and the tour is rotated
+    /// back to the anchor before it is reported.
+    pub wrap_ok: bool,
     /// Precedence including pins, in compressed form.
     succ_off: Vec<u32>,
     succ: Vec<u32>,
@@ -123,7 +127,7 @@ impl<'p, C: CostModel> Net<'p, C> {
                 group[t.index()] = g as u32;
             }
         }
-        Net {
+        let mut net = Net {
             p,
             n_tasks,
             n,
@@ -138,6 +142,7 @@ impl<'p, C: CostModel> Net<'p, C> {
             modes_self_reverse,
             reversal_symmetric,
             plain_symmetric,
+            wrap_ok: false,
             succ_off,
             succ,
             pred_off,
@@ -147,7 +152,9 @@ impl<'p, C: CostModel> Net<'p, C> {
             group,
             has_groups: !p.groups().is_empty(),
             multi_mode: p.max_modes() > 1,
-        }
+        };
+        net.wrap_ok = net.reversal_symmetric && depot_symmetric && !net.has_prec && !net.has_groups;
+        net
     }
 
     /// Number of modes of a node (the depot has one).

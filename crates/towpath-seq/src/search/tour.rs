@@ -210,6 +210,38 @@ impl Tour {
         self.refresh_pos(i, j);
     }
 
+    /// Reverses the cyclic stretch from position `a` forward to position `b` (it may wrap past the
+    /// end; position 0 then changes hands).
+    pub fn reverse_cyclic(&mut self, a: usize, b: usize) {
+        let n = self.seq.len();
+        if a <= b {
+            self.reverse(a, b);
+            return;
+        }
+        self.save_range(a, n - 1);
+        self.save_range(0, b);
+        let m = n - a + b + 1;
+        let (mut x, mut y) = (a, b);
+        for _ in 0..m / 2 {
+            self.seq.swap(x, y);
+            self.pos[self.seq[x] as usize] = x as u32;
+            self.pos[self.seq[y] as usize] = y as u32;
+            x = if x + 1 == n { 0 } else { x + 1 };
+            y = if y == 0 { n - 1 } else { y - 1 };
+        }
+    }
+
+    /// Rotates so that `v` is at position 0 (journaled).
+    pub fn rotate_to(&mut self, v: u32) {
+        let p = self.pos[v as usize] as usize;
+        if p != 0 {
+            let n = self.seq.len();
+            self.save_range(0, n - 1);
+            self.seq.rotate_left(p);
+            self.refresh_pos(0, n - 1);
+        }
+    }
+
     /// Exchanges the adjacent segments `i..=j` and `j+1..=k`.
     pub fn swap_adjacent(&mut self, i: usize, j: usize, k: usize) {
         self.save_range(i, k);
