@@ -15,7 +15,7 @@ use crate::cost::{Cost, CostModel};
 const MAX_SEGMENT: usize = 3;
 
 /// With precedence, Or-opt scans every position up to this size and uses candidate lists above.
-const SCAN_UP_TO: usize = 0;
+const SCAN_UP_TO: usize = 400;
 
 /// Longest segments the segment exchange considers.
 const SWAP_WINDOW: usize = 64;
