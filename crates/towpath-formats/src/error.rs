@@ -67,15 +67,9 @@ impl fmt::Display for FormatError {
     }
 }
 
-impl std::error::Error for FormatError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match &self.kind {
-            ErrorKind::Io(e) => Some(e),
-            ErrorKind::Model(e) => Some(e),
-            _ => None,
-        }
-    }
-}
+/// The message already includes the underlying I/O or model error, so no `source` is given (a
+/// reporter printing the chain would repeat it).
+impl std::error::Error for FormatError {}
 
 /// What is wrong with an input. Node and set numbers are the file's own (1-based); task names
 /// are the JSON file's task ids.

@@ -4,7 +4,7 @@
 use std::fmt;
 
 use serde::Serialize;
-use towpath_seq::{CostModel, MatrixCost, PointCost, Problem, Step, TaskId, Violation};
+use towpath_seq::{CostModel, End, MatrixCost, PointCost, Problem, Step, TaskId, Violation};
 
 /// What kind of file an instance came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -180,13 +180,19 @@ impl Instance {
         self.problem.num_tasks()
     }
 
-    /// The route `steps` in the file's own numbering (see [`Answer`]). A closed tour with no
-    /// fixed beginning is rotated to begin with task 0 (node 1 for TSP/ATSP, the first set for
-    /// GTSP, the first task for JSON). Steps naming tasks or modes the problem does not have are
+    /// The route `steps` in the file's own numbering (see [`Answer`]). A closed tour without a
+    /// start state is rotated: TSP/ATSP tours to begin at node 1, others to begin with the task
+    /// pinned first (the PCGLNS start set) or else task 0 (the first set, the first JSON task). Steps naming tasks or modes the problem does not have are
     /// skipped; pass routes through [`LoadedProblem::check`] first.
     pub fn answer(&self, steps: &[Step]) -> Answer {
-        let cyclic = with_problem!(&self.problem, p => p.is_cyclic() && p.first_task().is_none());
-        let offset = if cyclic { steps.iter().position(|s| s.task == TaskId(0)).unwrap_or(0) } else { 0 };
+        let (closed_cycle, first) =
+            with_problem!(&self.problem, p => (p.end() == End::Closed && p.start().is_none(), p.first_task()));
+        let target = match self.kind {
+            _ if !closed_cycle => None,
+            Kind::Tsp | Kind::Atsp => Some(TaskId(0)),
+            _ => Some(first.unwrap_or(TaskId(0))),
+        };
+        let offset = target.and_then(|t| steps.iter().position(|s| s.task == t)).unwrap_or(0);
         let rotated = steps.iter().skip(offset).chain(steps.iter().take(offset));
         match &self.numbering {
             Numbering::Nodes(node_of) => Answer::Nodes(
@@ -214,7 +220,22 @@ impl Instance {
                 }
             }
         }
-        nodes.iter().map(|&n| lookup.get(&n).copied().ok_or(UnknownNode(n))).collect()
+        let mut steps: Vec<Step> =
+            nodes.iter().map(|&n| lookup.get(&n).copied().ok_or(UnknownNode(n))).collect::<Result<_, _>>()?;
+        self.rotate_to_first(&mut steps);
+        Ok(steps)
+    }
+
+    /// A closed tour without a start state is a cycle: rotate it to begin with the task pinned
+    /// first, if any, so that the checker reads it from there.
+    fn rotate_to_first(&self, steps: &mut [Step]) {
+        let (closed_cycle, first) =
+            with_problem!(&self.problem, p => (p.end() == End::Closed && p.start().is_none(), p.first_task()));
+        if let (true, Some(f)) = (closed_cycle, first) {
+            if let Some(k) = steps.iter().position(|s| s.task == f) {
+                steps.rotate_left(k);
+            }
+        }
     }
 
     /// Turns a route given as JSON task ids with mode indices into steps (JSON problems only).
@@ -224,12 +245,14 @@ impl Instance {
         };
         let index: std::collections::HashMap<&str, u32> =
             ids.iter().enumerate().map(|(i, id)| (id.as_str(), i as u32)).collect();
-        route
+        let mut steps = route
             .iter()
             .map(|s| match index.get(s.task.as_str()) {
                 Some(&t) => Ok(Step { task: TaskId(t), mode: s.mode }),
                 None => Err(format!("unknown task id \"{}\"", s.task)),
             })
-            .collect()
+            .collect::<Result<Vec<_>, _>>()?;
+        self.rotate_to_first(&mut steps);
+        Ok(steps)
     }
 }

@@ -10,6 +10,9 @@
 //!   ([`Instance::answer`], [`Instance::steps_from_nodes`]).
 //! - [`parse_tsplib`]: TSPLIB TSP and ATSP (every coordinate type towpath's cost models know,
 //!   and EXPLICIT matrices in all nine layouts), SOP, GTSP/AGTSP (GLNS format) and PCGLNS.
+//! - [`parse_json`] / [`JsonProblem`]: towpath's own JSON format (tasks with modes, precedence,
+//!   consecutive groups, route ends; states as points with a metric or as a matrix), described
+//!   in `docs/json-format.md`; [`write_json`] writes it.
 //! - [`read_tour`] / [`parse_tour`]: TSPLIB tours, to price known optimal tours.
 //! - Every refusal is a [`FormatError`]: file, line (and column for JSON) and an [`ErrorKind`].
 //!   No input makes a reader panic.
@@ -19,6 +22,8 @@
 mod coords;
 mod error;
 mod instance;
+mod json;
+mod json_locate;
 mod matrix;
 mod sets;
 mod text;
@@ -29,6 +34,9 @@ use std::path::Path;
 
 pub use error::{ErrorKind, FormatError};
 pub use instance::{Answer, Instance, Kind, LoadedProblem, TaskStep, UnknownNode};
+pub use json::{
+    parse_json, parse_json_problem, write_json, JsonEnd, JsonMetric, JsonMode, JsonProblem, JsonStates, JsonTask,
+};
 pub use matrix::WeightFormat;
 pub use tour::{parse_tour, Tour};
 pub use tsplib::parse_tsplib;
@@ -45,11 +53,18 @@ pub fn read_instance(path: &Path) -> Result<Instance, FormatError> {
     parse_instance(&read_text(path)?, path)
 }
 
-/// Parses a problem of any supported format. TSPLIB-style text is recognised by its keywords and
-/// its kind by `TYPE` and the sections present (a `GTSP_SET_SECTION` makes it a GTSP whatever
+/// Parses a problem of any supported format: text whose first non-blank character is `{` (or a
+/// `.json` file) is towpath's JSON format; anything else is read as TSPLIB-style keywords, its
+/// kind given by `TYPE` and the sections present (a `GTSP_SET_SECTION` makes it a GTSP whatever
 /// `TYPE` says). `path` names the input in error messages and gives the default name.
 pub fn parse_instance(text: &str, path: &Path) -> Result<Instance, FormatError> {
-    parse_tsplib(text, path)
+    let is_json = text.trim_start_matches('\u{feff}').trim_start().starts_with('{')
+        || path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    if is_json {
+        parse_json(text.trim_start_matches('\u{feff}'), path)
+    } else {
+        parse_tsplib(text, path)
+    }
 }
 
 /// Reads a TSPLIB tour file; see [`parse_tour`].

@@ -18,9 +18,10 @@ use towpath_seq::{End, MatrixCost, Metric, Mode, ModelError, PointCost, Problem,
 use crate::coords::read_coords;
 use crate::error::{ErrorKind, FormatError};
 use crate::instance::{Instance, Kind, LoadedProblem, Numbering};
+use crate::matrix::parse_integer;
 use crate::matrix::{read_matrix, WeightFormat};
 use crate::sets::{read_ordering, read_sets, read_start};
-use crate::text::{lex, Document};
+use crate::text::{lex, Document, Section};
 
 /// The coordinate edge-weight types: (name, coordinates per node, metric).
 const COORD_TYPES: &[(&str, usize, Metric)] = &[
@@ -55,7 +56,11 @@ pub fn parse_tsplib(text: &str, path: &Path) -> Result<Instance, FormatError> {
     let costs = read_costs(&doc, kind, n, path)?;
     let (problem, numbering) = match kind {
         Kind::Tsp | Kind::Atsp => {
-            (build_tsp(costs, n, path)?, Numbering::Nodes((1..=n as u32).map(|v| vec![v]).collect()))
+            let fixed = match doc.section("FIXED_EDGES_SECTION") {
+                Some(s) => read_fixed_edge(s, n, path)?,
+                None => None,
+            };
+            (build_tsp(costs, n, fixed, path)?, Numbering::Nodes((1..=n as u32).map(|v| vec![v]).collect()))
         }
         Kind::Sop => (build_sop(costs, n, path)?, Numbering::Nodes((1..=n as u32).map(|v| vec![v]).collect())),
         Kind::Gtsp | Kind::Pcgtsp => build_gtsp(&doc, kind, costs, n, path)?,
@@ -119,6 +124,7 @@ fn check_sections(doc: &Document<'_>, kind: Kind, path: &Path) -> Result<(), For
             "NODE_COORD_SECTION" | "EDGE_WEIGHT_SECTION" | "DISPLAY_DATA_SECTION" => true,
             "GTSP_SET_SECTION" => matches!(kind, Kind::Gtsp | Kind::Pcgtsp),
             "GTSP_SET_ORDERING" | "START_GROUP_SECTION" => kind == Kind::Pcgtsp,
+            "FIXED_EDGES_SECTION" => matches!(kind, Kind::Tsp | Kind::Atsp),
             _ => false,
         };
         if !ok {
@@ -220,15 +226,61 @@ fn matrix(n: usize, data: Vec<f64>, path: &Path) -> Result<MatrixCost, FormatErr
         .ok_or_else(|| FormatError::in_file(path, ErrorKind::Unsupported("internal: matrix size mismatch".into())))
 }
 
-fn build_tsp(costs: Costs, n: usize, path: &Path) -> Result<LoadedProblem, FormatError> {
-    fn tsp<C: towpath_seq::CostModel>(cost: C, n: usize, path: &Path) -> Result<Problem<C>, FormatError> {
+/// `FIXED_EDGES_SECTION`: `a b` pairs ended by -1. One fixed edge is supported (it makes the
+/// tour a Hamiltonian path from b to a closed by the edge, as in TSPLIB's linhp318); more are
+/// refused. Returns the 0-based `(a, b)`.
+fn read_fixed_edge(section: &Section<'_>, n: usize, path: &Path) -> Result<Option<(u32, u32)>, FormatError> {
+    let mut nodes = Vec::new();
+    for (line, tok) in section.tokens() {
+        let v = parse_integer(tok, line, path)?;
+        if v == -1 {
+            break;
+        }
+        let idx = usize::try_from(v)
+            .ok()
+            .filter(|&x| (1..=n).contains(&x))
+            .ok_or_else(|| FormatError::at_line(path, line, ErrorKind::NodeOutOfRange { node: v, dimension: n }))?;
+        nodes.push(((idx - 1) as u32, line));
+    }
+    match nodes.as_slice() {
+        [] => Ok(None),
+        [(a, _), (b, line)] => {
+            if a == b {
+                return Err(FormatError::at_line(
+                    path,
+                    *line,
+                    ErrorKind::Unsupported(format!("fixed edge {} {} is a loop", a + 1, b + 1)),
+                ));
+            }
+            Ok(Some((*a, *b)))
+        }
+        [_] => Err(FormatError::at_line(path, section.last_line(), ErrorKind::Unterminated("the fixed edge".into()))),
+        _ => Err(FormatError::at_line(
+            path,
+            section.line,
+            ErrorKind::Unsupported("FIXED_EDGES_SECTION with more than one edge is not supported".into()),
+        )),
+    }
+}
+
+fn build_tsp(costs: Costs, n: usize, fixed: Option<(u32, u32)>, path: &Path) -> Result<LoadedProblem, FormatError> {
+    fn tsp<C: towpath_seq::CostModel>(
+        cost: C,
+        n: usize,
+        fixed: Option<(u32, u32)>,
+        path: &Path,
+    ) -> Result<Problem<C>, FormatError> {
         let mut b = Problem::builder(cost);
         b.point_tasks(n).end(End::Closed);
+        // The tour uses edge a -> b: begin at b, end at a, and the closing move is the edge.
+        if let Some((a, bb)) = fixed {
+            b.first(TaskId(bb)).last(TaskId(a));
+        }
         b.build().map_err(|e| FormatError::in_file(path, ErrorKind::Model(e)))
     }
     Ok(match costs {
-        Costs::Points(p) => LoadedProblem::Points(tsp(p, n, path)?),
-        Costs::Matrix { n, data, .. } => LoadedProblem::Matrix(tsp(matrix(n, data, path)?, n, path)?),
+        Costs::Points(p) => LoadedProblem::Points(tsp(p, n, fixed, path)?),
+        Costs::Matrix { n, data, .. } => LoadedProblem::Matrix(tsp(matrix(n, data, path)?, n, fixed, path)?),
     })
 }
 
