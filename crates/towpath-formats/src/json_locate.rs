@@ -161,7 +161,7 @@ mod tests {
     fn finds_nested_values() {
         let t = "{\n  \"a\": {\"x\": \"}\"},\n  \"precedence\": [\n    [\"p\", \"q\"],\n    [\"r\",  \"s\"]\n  ]\n}";
         let p = [Seg::Key("precedence"), Seg::Index(1), Seg::Index(1)];
-        assert_eq!(locate(t, &p), Some((5, 11)));
+        assert_eq!(locate(t, &p), Some((5, 12)));
         assert_eq!(path_text(&p), "precedence[1][1]");
         assert_eq!(locate(t, &[Seg::Key("missing")]), None);
         assert_eq!(locate("{\"a\": [1", &[Seg::Key("a"), Seg::Index(3)]), None);

@@ -226,9 +226,10 @@ fn matrix(n: usize, data: Vec<f64>, path: &Path) -> Result<MatrixCost, FormatErr
         .ok_or_else(|| FormatError::in_file(path, ErrorKind::Unsupported("internal: matrix size mismatch".into())))
 }
 
-/// `FIXED_EDGES_SECTION`: `a b` pairs ended by -1. One fixed edge is supported (it makes the
-/// tour a Hamiltonian path from b to a closed by the edge, as in TSPLIB's linhp318); more are
-/// refused. Returns the 0-based `(a, b)`.
+/// `FIXED_EDGES_SECTION`: `a b` pairs ended by -1. One fixed edge is supported, as in TSPLIB's
+/// linhp318 (the Hamiltonian-path version of lin318): the problem becomes the open path from b
+/// to a, whose cost is the tour's less the fixed edge's (a constant), which is also the value
+/// TSPLIB publishes. More edges are refused. Returns the 0-based `(a, b)`.
 fn read_fixed_edge(section: &Section<'_>, n: usize, path: &Path) -> Result<Option<(u32, u32)>, FormatError> {
     let mut nodes = Vec::new();
     for (line, tok) in section.tokens() {
@@ -272,9 +273,10 @@ fn build_tsp(costs: Costs, n: usize, fixed: Option<(u32, u32)>, path: &Path) -> 
     ) -> Result<Problem<C>, FormatError> {
         let mut b = Problem::builder(cost);
         b.point_tasks(n).end(End::Closed);
-        // The tour uses edge a -> b: begin at b, end at a, and the closing move is the edge.
-        if let Some((a, bb)) = fixed {
-            b.first(TaskId(bb)).last(TaskId(a));
+        if let Some((a, z)) = fixed {
+            // A tour through the edge a-b is a Hamiltonian path from b to a plus the edge's own
+            // (constant) cost: solve the path, as TSPLIB's published value for linhp318 does.
+            b.end(End::Free).first(TaskId(z)).last(TaskId(a));
         }
         b.build().map_err(|e| FormatError::in_file(path, ErrorKind::Model(e)))
     }
