@@ -1,7 +1,7 @@
 //! `towpath solve FILE`: reads a problem (TSPLIB TSP/ATSP/SOP, GTSP-LIB, PCGLNS or towpath
 //! JSON), solves it, checks the answer independently and prints it in the file's numbering.
 
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
@@ -86,8 +86,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let cost = instance.problem.check(&report.solution.steps).map_err(|v| {
         exit::check_failed(anyhow!("{}: the solver's answer does not verify: {v}", args.file.display()))
     })?;
-    print_answer(&args, &instance, &report, cost, threads);
-    Ok(())
+    match print_answer(&args, &instance, &report, cost, threads) {
+        // A closed pipe (`towpath solve ... | head -1`) is not an error of ours.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => Ok(other?),
+    }
 }
 
 /// A progress bar on stderr, only when stderr is a terminal.
@@ -102,10 +105,18 @@ fn progress_bar(bounded: bool) -> Option<indicatif::ProgressBar> {
     Some(bar)
 }
 
-fn print_answer(args: &Args, instance: &Instance, report: &SolveReport, cost: f64, threads: usize) {
+fn print_answer(
+    args: &Args,
+    instance: &Instance,
+    report: &SolveReport,
+    cost: f64,
+    threads: usize,
+) -> std::io::Result<()> {
+    let mut out = std::io::stdout().lock();
     let tour = instance.answer(&report.solution.steps);
     if args.json {
-        println!(
+        writeln!(
+            out,
             "{}",
             serde_json::json!({
                 "file": args.file.display().to_string(),
@@ -121,10 +132,11 @@ fn print_answer(args: &Args, instance: &Instance, report: &SolveReport, cost: f6
                 "seed": args.seed,
                 "threads": threads,
             })
-        );
-        return;
+        )?;
+        return out.flush();
     }
-    println!(
+    writeln!(
+        out,
         "{} ({}, dimension {}, {} tasks): cost {} in {:.2} s, {} iterations{} (seed {}, {} threads); checked",
         instance.name,
         instance.kind,
@@ -136,13 +148,14 @@ fn print_answer(args: &Args, instance: &Instance, report: &SolveReport, cost: f6
         if report.exact { ", proven optimal" } else { "" },
         args.seed,
         threads
-    );
+    )?;
     const SHOWN: usize = 40;
     let text = tour.to_string();
     if tour.len() <= SHOWN {
-        println!("tour: {text}");
+        writeln!(out, "tour: {text}")?;
     } else {
         let head: Vec<&str> = text.split(' ').take(SHOWN).collect();
-        println!("tour: {} … ({} steps; --json prints all)", head.join(" "), tour.len());
+        writeln!(out, "tour: {} … ({} steps; --json prints all)", head.join(" "), tour.len())?;
     }
+    out.flush()
 }
