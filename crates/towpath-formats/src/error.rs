@@ -10,7 +10,11 @@ use towpath_seq::ModelError;
 /// `path: problem` when no line applies), e.g.
 /// `kroA100.tsp:57: expected 2 coordinates for node 55, found 1`.
 #[derive(Debug)]
-pub struct FormatError {
+pub struct FormatError(Box<Located>);
+
+/// The parts of a [`FormatError`], boxed to keep `Result`s small.
+#[derive(Debug)]
+struct Located {
     path: PathBuf,
     line: Option<usize>,
     column: Option<usize>,
@@ -18,52 +22,56 @@ pub struct FormatError {
 }
 
 impl FormatError {
+    fn new(path: &Path, line: Option<usize>, column: Option<usize>, kind: ErrorKind) -> Self {
+        FormatError(Box::new(Located { path: path.to_path_buf(), line, column, kind }))
+    }
+
     /// An error at a line (1-based) of a file.
     pub fn at_line(path: &Path, line: usize, kind: ErrorKind) -> Self {
-        FormatError { path: path.to_path_buf(), line: Some(line), column: None, kind }
+        Self::new(path, Some(line), None, kind)
     }
 
     /// An error at a line and column (both 1-based) of a file.
     pub fn at(path: &Path, line: usize, column: usize, kind: ErrorKind) -> Self {
-        FormatError { path: path.to_path_buf(), line: Some(line), column: Some(column), kind }
+        Self::new(path, Some(line), Some(column), kind)
     }
 
     /// An error about a file as a whole (a missing keyword, an unreadable file).
     pub fn in_file(path: &Path, kind: ErrorKind) -> Self {
-        FormatError { path: path.to_path_buf(), line: None, column: None, kind }
+        Self::new(path, None, None, kind)
     }
 
     /// The file the error is about, as the caller named it.
     pub fn path(&self) -> &Path {
-        &self.path
+        &self.0.path
     }
 
     /// The 1-based line of the problem, if one applies.
     pub fn line(&self) -> Option<usize> {
-        self.line
+        self.0.line
     }
 
     /// The 1-based column of the problem (JSON only).
     pub fn column(&self) -> Option<usize> {
-        self.column
+        self.0.column
     }
 
     /// What is wrong.
     pub fn kind(&self) -> &ErrorKind {
-        &self.kind
+        &self.0.kind
     }
 }
 
 impl fmt::Display for FormatError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.path.display())?;
-        if let Some(l) = self.line {
+        write!(f, "{}", self.0.path.display())?;
+        if let Some(l) = self.0.line {
             write!(f, ":{l}")?;
-            if let Some(c) = self.column {
+            if let Some(c) = self.0.column {
                 write!(f, ":{c}")?;
             }
         }
-        write!(f, ": {}", self.kind)
+        write!(f, ": {}", self.0.kind)
     }
 }
 
