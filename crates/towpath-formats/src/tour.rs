@@ -17,7 +17,8 @@ pub struct Tour {
 
 /// Parses a TSPLIB tour. The first tour of `TOUR_SECTION` is read (up to its -1, or to the end
 /// of the section). Node numbers must be positive and distinct; if `DIMENSION` is given the
-/// tour must have that many nodes, each at most `DIMENSION`.
+/// tour must have that many entries (for a GTSP tour, one per set, so node numbers may exceed
+/// it). Whether the nodes belong to a problem is checked by [`crate::Instance::steps_from_nodes`].
 pub fn parse_tour(text: &str, path: &Path) -> Result<Tour, FormatError> {
     let doc = lex(text, path)?;
     if let Some(s) = doc.sections.iter().find(|s| s.name != "TOUR_SECTION") {
@@ -47,11 +48,17 @@ pub fn parse_tour(text: &str, path: &Path) -> Result<Tour, FormatError> {
         if v == -1 {
             break;
         }
-        let bound = dimension.unwrap_or(u32::MAX as usize);
-        let node = u32::try_from(v)
-            .ok()
-            .filter(|&x| x >= 1 && (x as usize) <= bound)
-            .ok_or_else(|| FormatError::at_line(path, line, ErrorKind::NodeOutOfRange { node: v, dimension: bound }))?;
+        let node = u32::try_from(v).ok().filter(|&x| x >= 1).ok_or_else(|| {
+            FormatError::at_line(
+                path,
+                line,
+                ErrorKind::BadValue {
+                    key: "TOUR_SECTION".into(),
+                    value: tok.into(),
+                    expected: "a node number (1 or more) or -1".into(),
+                },
+            )
+        })?;
         if let Some(&first) = first_line.get(&node) {
             return Err(FormatError::at_line(
                 path,

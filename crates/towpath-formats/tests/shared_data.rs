@@ -49,6 +49,42 @@ fn every_shared_instance_parses_and_optimal_tours_price_right() {
     println!("{ok} read, {refused} refused, {tours} optimal tours priced");
 }
 
+/// MIP-proven optimal PCGTSP tours (one node per set, from the start set) published in
+/// ukoloff/PCGTSP-BnB `Salman/output/*.result.txt`, priced by our model of the PCGLNS files.
+#[test]
+#[ignore]
+fn published_pcgtsp_optima_price_exactly() {
+    let Some(dir) = data_dir() else {
+        eprintln!("no shared data; skipped");
+        return;
+    };
+    let tours: [(&str, f64, &[u32]); 2] = [
+        (
+            "ESC47",
+            1063.0,
+            &[
+                1, 2, 70, 133, 9, 162, 84, 127, 146, 216, 163, 27, 99, 181, 244, 15, 173, 156, 24, 96, 114, 107, 221,
+                41, 125, 119, 183, 68, 74, 111, 224, 179, 199, 189, 30, 57, 130, 53, 194, 169, 231, 34, 90, 48, 144,
+                72, 153, 209,
+            ],
+        ),
+        (
+            "prob.42",
+            202.0,
+            &[
+                1, 63, 18, 78, 35, 148, 181, 29, 119, 108, 178, 93, 140, 128, 195, 2, 187, 177, 103, 193, 20, 4, 39,
+                122, 14, 185, 89, 45, 85, 60, 110, 68, 169, 175, 142, 94, 157, 114, 205, 167, 191,
+            ],
+        ),
+    ];
+    for (name, cost, nodes) in tours {
+        let inst = towpath_formats::read_instance(&dir.join(format!("pcgtsp/{name}.pcglns"))).unwrap();
+        let steps = inst.steps_from_nodes(nodes).unwrap();
+        assert_eq!(inst.problem.check(&steps).unwrap(), cost, "{name}");
+        println!("{name}: published optimal tour priced {cost}");
+    }
+}
+
 /// Splits one CSV row, honouring double quotes.
 fn split_csv(row: &str) -> Vec<String> {
     let mut out = vec![String::new()];

@@ -150,8 +150,8 @@ fn tour_errors() {
     assert_eq!(e.to_string(), "x.tour:5: node 3 is given twice (first on line 4)");
     let e = t("TYPE: TOUR\nDIMENSION: 3\nTOUR_SECTION\n1 3\n-1\n").unwrap_err();
     assert!(e.to_string().contains("expected 3"), "{e}");
-    let e = t("TYPE: TOUR\nDIMENSION: 3\nTOUR_SECTION\n1 4 2\n-1\n").unwrap_err();
-    assert_eq!(e.line(), Some(4));
+    let e = t("TYPE: TOUR\nDIMENSION: 3\nTOUR_SECTION\n1 3\n0\n-1\n").unwrap_err();
+    assert_eq!(e.to_string(), "x.tour:5: TOUR_SECTION: `0` is not a node number (1 or more) or -1");
     assert!(t("TYPE: TOUR\nDIMENSION: 3\n").unwrap_err().to_string().contains("missing TOUR_SECTION"));
 }
 
