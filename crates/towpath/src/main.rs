@@ -19,12 +19,15 @@ struct Cli {
 enum Command {
     /// Run the built-in demo: a generated part, sequenced and checked, with no files of your own.
     Demo(cmd::demo::Args),
+    /// Solve a TSPLIB (TSP, ATSP, SOP), GTSP-LIB, PCGLNS or towpath JSON problem file.
+    Solve(cmd::solve::Args),
 }
 
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Demo(args) => cmd::demo::run(args),
+        Command::Solve(args) => cmd::solve::run(args),
     };
     std::process::exit(exit::report(result));
 }

@@ -1,0 +1,7 @@
+//! Integration tests of the readers: one test binary, one module per concern.
+
+mod common;
+mod errors;
+mod json;
+mod known;
+mod props;

@@ -1,0 +1,161 @@
+//! `towpath solve FILE`: reads a problem (TSPLIB TSP/ATSP/SOP, GTSP-LIB, PCGLNS or towpath
+//! JSON), solves it, checks the answer independently and prints it in the file's numbering.
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::anyhow;
+use towpath_formats::{read_instance, with_problem, Instance};
+use towpath_seq::{Progress, SolveOptions, SolveReport};
+
+use crate::exit;
+
+/// Arguments of `towpath solve`.
+#[derive(clap::Args, Debug)]
+#[command(after_help = "Examples:
+  towpath solve kroA100.tsp                      # 10 s on all cores
+  towpath solve ESC07.sop --iterations 2000 --threads 1 --seed 3 --json
+  towpath solve part.json --time-limit 60
+
+The file kind is recognised from its content: a JSON object is towpath's JSON problem format
+(docs/json-format.md); otherwise TSPLIB keywords, with TYPE TSP, ATSP, SOP, GTSP, AGTSP or
+PCGLNS. The tour is printed in the file's numbering: 1-based nodes (TSP/ATSP from node 1, SOP
+from node 1 to node n, GTSP/PCGLNS one node per set), or task ids with mode indices for JSON.
+With --iterations and no --time-limit the answer depends only on the file, --seed and --threads.")]
+pub struct Args {
+    /// The problem file.
+    pub file: PathBuf,
+    /// Stop after this many seconds (default 10, unless --iterations is given).
+    #[arg(long, value_name = "SECONDS")]
+    pub time_limit: Option<f64>,
+    /// Work budget: improvement kicks summed over threads. Without --time-limit there is then
+    /// no time limit.
+    #[arg(long, value_name = "N")]
+    pub iterations: Option<u64>,
+    /// Seed for the solver's random choices.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Worker threads (default: the machine's available cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print one JSON object on stdout instead of a summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The default time limit when neither a time limit nor a work budget is given.
+const DEFAULT_TIME_LIMIT: f64 = 10.0;
+
+/// Runs `towpath solve`.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let time_limit = match (args.time_limit, args.iterations) {
+        (Some(t), _) => {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(exit::bad_input(anyhow!("--time-limit must be a non-negative number of seconds, got {t}")));
+            }
+            Some(Duration::from_secs_f64(t))
+        }
+        (None, Some(_)) => None,
+        (None, None) => Some(Duration::from_secs_f64(DEFAULT_TIME_LIMIT)),
+    };
+    let threads = args.threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1);
+    let instance = read_instance(&args.file).map_err(exit::bad_input)?;
+
+    let bar = progress_bar(time_limit.is_some() || args.iterations.is_some());
+    let progress = bar.clone().map(|bar| {
+        Arc::new(move |p: &Progress| {
+            bar.set_position((p.fraction * 1000.0) as u64);
+            bar.set_message(format!("best {}", p.best_cost));
+        }) as towpath_seq::ProgressFn
+    });
+    let options = SolveOptions {
+        time_limit,
+        iterations: args.iterations,
+        seed: args.seed,
+        threads,
+        progress,
+        ..SolveOptions::default()
+    };
+    let report: SolveReport = with_problem!(&instance.problem, p => towpath_seq::solve(p, &options))
+        .map_err(|e| exit::bad_input(anyhow!("{}: {e}", args.file.display())))?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    let cost = instance.problem.check(&report.solution.steps).map_err(|v| {
+        exit::check_failed(anyhow!("{}: the solver's answer does not verify: {v}", args.file.display()))
+    })?;
+    match print_answer(&args, &instance, &report, cost, threads) {
+        // A closed pipe (`towpath solve ... | head -1`) is not an error of ours.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => Ok(other?),
+    }
+}
+
+/// A progress bar on stderr, only when stderr is a terminal.
+fn progress_bar(bounded: bool) -> Option<indicatif::ProgressBar> {
+    if !bounded || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(1000);
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {msg}") {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    Some(bar)
+}
+
+fn print_answer(
+    args: &Args,
+    instance: &Instance,
+    report: &SolveReport,
+    cost: f64,
+    threads: usize,
+) -> std::io::Result<()> {
+    let mut out = std::io::stdout().lock();
+    let tour = instance.answer(&report.solution.steps);
+    if args.json {
+        writeln!(
+            out,
+            "{}",
+            serde_json::json!({
+                "file": args.file.display().to_string(),
+                "name": instance.name,
+                "type": instance.kind.as_str(),
+                "dimension": instance.dimension,
+                "tasks": instance.num_tasks(),
+                "cost": cost,
+                "tour": tour,
+                "time_seconds": report.elapsed.as_secs_f64(),
+                "iterations": report.iterations,
+                "exact": report.exact,
+                "seed": args.seed,
+                "threads": threads,
+            })
+        )?;
+        return out.flush();
+    }
+    writeln!(
+        out,
+        "{} ({}, dimension {}, {} tasks): cost {} in {:.2} s, {} iterations{} (seed {}, {} threads); checked",
+        instance.name,
+        instance.kind,
+        instance.dimension,
+        instance.num_tasks(),
+        cost,
+        report.elapsed.as_secs_f64(),
+        report.iterations,
+        if report.exact { ", proven optimal" } else { "" },
+        args.seed,
+        threads
+    )?;
+    const SHOWN: usize = 40;
+    let text = tour.to_string();
+    if tour.len() <= SHOWN {
+        writeln!(out, "tour: {text}")?;
+    } else {
+        let head: Vec<&str> = text.split(' ').take(SHOWN).collect();
+        writeln!(out, "tour: {} … ({} steps; --json prints all)", head.join(" "), tour.len())?;
+    }
+    out.flush()
+}
