@@ -19,12 +19,16 @@ struct Cli {
 enum Command {
     /// Run the built-in demo: a generated part, sequenced and checked, with no files of your own.
     Demo(cmd::demo::Args),
+    /// Generate the fiber courses of a ply on a mold surface (mesh or analytic), trimmed per tow,
+    /// with quality figures; write JSON, CSV and G-code.
+    Layup(cmd::layup::Args),
 }
 
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Demo(args) => cmd::demo::run(args),
+        Command::Layup(args) => cmd::layup::run(args),
     };
     std::process::exit(exit::report(result));
 }
