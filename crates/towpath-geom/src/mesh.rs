@@ -80,6 +80,8 @@ pub struct Mesh {
     vertex_faces: Vec<u32>,
     boundary_loops: Vec<Vec<u32>>,
     index: OnceLock<RTree<FaceBox>>,
+    /// Closest-point queries answered by scanning before the index is built.
+    scans: std::sync::atomic::AtomicUsize,
 }
 
 impl Mesh {
@@ -122,7 +124,7 @@ impl Mesh {
                 (k, i)
             })
             .collect();
-        keyed.sort_unstable();
+        rayon::slice::ParallelSliceMut::par_sort_unstable(&mut keyed[..]);
         let mut keep = vec![true; tris.len()];
         for w in keyed.windows(2) {
             if w[0].0 == w[1].0 {
@@ -153,10 +155,10 @@ impl Mesh {
         let positions = compact;
         report.vertices_out = positions.len();
         let areas: Vec<f64> = tris.iter().map(|t| tri_area(corners(&positions, t))).collect();
-        if opts.orient {
-            report.flipped = topology::orient(&mut tris, &areas);
-        }
-        let topo = topology::build(&tris);
+        let half = topology::half_edges(&tris);
+        let flipped = if opts.orient { topology::orient(&mut tris, &areas, &half) } else { Vec::new() };
+        report.flipped = flipped.iter().filter(|&&f| f).count();
+        let topo = topology::build(&tris, &half, &flipped);
         report.non_manifold_edges = topo.non_manifold_edges;
         report.orientation_conflicts = topo.orientation_conflicts;
         let mesh = Mesh::assemble(positions, tris, topo);
@@ -210,6 +212,7 @@ impl Mesh {
             vertex_faces,
             boundary_loops,
             index: OnceLock::new(),
+            scans: std::sync::atomic::AtomicUsize::new(0),
         }
     }
 
@@ -330,14 +333,42 @@ impl Mesh {
         let _ = self.index();
     }
 
-    /// The closest point of the mesh to `p` (exact: point–triangle distances through an R-tree of
-    /// face bounding boxes).
+    /// The closest point of the mesh to `p` (exact point–triangle distances). The first few
+    /// queries scan all faces (cheaper than building an index for a handful of projections); later
+    /// ones go through an R-tree of face bounding boxes built on first need.
     pub fn closest_point(&self, p: DVec3) -> Option<SurfacePoint> {
+        use std::sync::atomic::Ordering;
+        if self.index.get().is_none() && self.scans.fetch_add(1, Ordering::Relaxed) < 8 {
+            return self.closest_point_scan(p);
+        }
         let q = [p.x, p.y, p.z];
         let fb = self.index().nearest_neighbor(&q)?;
         let [a, b, c] = fb.c;
         let w = closest_point_on_triangle(p, a, b, c);
         Some(SurfacePoint { face: fb.face, bary: w })
+    }
+
+    /// Closest point by scanning every face (exact; ties go to the lowest face index).
+    pub fn closest_point_scan(&self, p: DVec3) -> Option<SurfacePoint> {
+        let mut best: Option<(f64, u32, DVec3)> = None;
+        for f in 0..self.triangles.len() as u32 {
+            let [a, b, c] = self.corners(f);
+            // Cheap reject by the bounding sphere of the face.
+            if let Some((bd, _, _)) = best {
+                let centre = (a + b + c) / 3.0;
+                let r = centre.distance(a).max(centre.distance(b)).max(centre.distance(c));
+                let dc = centre.distance(p) - r;
+                if dc > 0.0 && dc * dc > bd {
+                    continue;
+                }
+            }
+            let w = closest_point_on_triangle(p, a, b, c);
+            let d = (a * w.x + b * w.y + c * w.z).distance_squared(p);
+            if best.is_none_or(|(bd, _, _)| d < bd) {
+                best = Some((d, f, w));
+            }
+        }
+        best.map(|(_, face, bary)| SurfacePoint { face, bary })
     }
 
     /// Faces whose bounding box comes within `r` of `p`.

@@ -30,16 +30,42 @@ pub struct EdgeRec {
     pub faces: [u32; 2],
 }
 
-/// Builds edges and neighbours of triangles that are already oriented as they should be.
-pub(crate) fn build(tris: &[[u32; 3]]) -> Topology {
-    let mut half: Vec<(u32, u32, u32)> = Vec::with_capacity(tris.len() * 3);
+/// Half-edges grouped by undirected edge: (min vertex << 32 | max vertex, face · 3 + local edge),
+/// sorted. Flipping a face (swapping its corners 1 and 2) keeps its undirected edges, so one
+/// sorted list serves orientation and topology.
+pub(crate) fn half_edges(tris: &[[u32; 3]]) -> Vec<(u64, u32)> {
+    let mut half: Vec<(u64, u32)> = Vec::with_capacity(tris.len() * 3);
     for (f, t) in tris.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
-            half.push((a.min(b), a.max(b), (f as u32) * 3 + k as u32));
+            half.push((((a.min(b) as u64) << 32) | a.max(b) as u64, (f as u32) * 3 + k as u32));
         }
     }
-    half.sort_unstable();
+    rayon::slice::ParallelSliceMut::par_sort_unstable(&mut half[..]);
+    half
+}
+
+/// Local edge index after a face flip ([v0, v1, v2] → [v0, v2, v1]): edge 0 ↔ edge 2.
+#[inline]
+fn flipped_edge(k: usize, flipped: bool) -> usize {
+    if flipped {
+        [2, 1, 0][k]
+    } else {
+        k
+    }
+}
+
+/// Builds edges and neighbours of triangles that are already oriented as they should be, from
+/// the half-edge list made before the faces in `flipped` were flipped.
+pub(crate) fn build(tris: &[[u32; 3]], half_in: &[(u64, u32)], flipped: &[bool]) -> Topology {
+    let half: Vec<(u32, u32, u32)> = half_in
+        .iter()
+        .map(|&(key, fk)| {
+            let (f, k) = (fk / 3, (fk % 3) as usize);
+            let k = flipped_edge(k, flipped.get(f as usize).copied().unwrap_or(false));
+            ((key >> 32) as u32, key as u32, f * 3 + k as u32)
+        })
+        .collect();
     let mut topo = Topology {
         neighbors: vec![[NO_FACE; 3]; tris.len()],
         edges: Vec::with_capacity(tris.len() * 3 / 2 + 1),
@@ -85,32 +111,25 @@ pub(crate) fn build(tris: &[[u32; 3]]) -> Topology {
 /// a breadth-first walk from the first face of each component flips every face that runs a
 /// shared edge the same way as its already-visited neighbour. A component is then flipped as a
 /// whole when the flipped faces outweigh the kept ones by area, so the input's majority
-/// orientation is kept. Returns the number of faces flipped.
-pub(crate) fn orient(tris: &mut [[u32; 3]], areas: &[f64]) -> usize {
+/// orientation is kept. Returns which faces were flipped.
+pub(crate) fn orient(tris: &mut [[u32; 3]], areas: &[f64], half: &[(u64, u32)]) -> Vec<bool> {
     // Undirected adjacency through edges with exactly two faces.
-    let mut half: Vec<(u32, u32, u32)> = Vec::with_capacity(tris.len() * 3);
-    for (f, t) in tris.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            half.push((a.min(b), a.max(b), f as u32));
-        }
-    }
-    half.sort_unstable();
     let mut adj_start = vec![0u32; tris.len() + 1];
     let mut pairs: Vec<(u32, u32)> = Vec::new();
     let mut i = 0;
     while i < half.len() {
         let mut j = i + 1;
-        while j < half.len() && half[j].0 == half[i].0 && half[j].1 == half[i].1 {
+        while j < half.len() && half[j].0 == half[i].0 {
             j += 1;
         }
-        if j - i == 2 && half[i].2 != half[i + 1].2 {
-            pairs.push((half[i].2, half[i + 1].2));
-            pairs.push((half[i + 1].2, half[i].2));
+        let (fa, fb) = (half[i].1 / 3, half.get(i + 1).map_or(u32::MAX, |h| h.1 / 3));
+        if j - i == 2 && fa != fb {
+            pairs.push((fa, fb));
+            pairs.push((fb, fa));
         }
         i = j;
     }
-    pairs.sort_unstable();
+    rayon::slice::ParallelSliceMut::par_sort_unstable(&mut pairs[..]);
     for &(f, _) in &pairs {
         adj_start[f as usize + 1] += 1;
     }
@@ -120,7 +139,6 @@ pub(crate) fn orient(tris: &mut [[u32; 3]], areas: &[f64]) -> usize {
     let mut flip = vec![false; tris.len()];
     let mut seen = vec![false; tris.len()];
     let mut queue = std::collections::VecDeque::new();
-    let mut flipped_total = 0;
     for seed in 0..tris.len() {
         if seen[seed] {
             continue;
@@ -159,10 +177,9 @@ pub(crate) fn orient(tris: &mut [[u32; 3]], areas: &[f64]) -> usize {
     for (t, &fl) in tris.iter_mut().zip(&flip) {
         if fl {
             t.swap(1, 2);
-            flipped_total += 1;
         }
     }
-    flipped_total
+    flip
 }
 
 fn oriented(t: [u32; 3], flip: bool) -> [u32; 3] {

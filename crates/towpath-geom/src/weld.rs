@@ -21,6 +21,7 @@ pub fn weld(positions: &[DVec3], tol: f64) -> (Vec<DVec3>, Vec<u32>) {
     if tol == 0.0 {
         // Exact duplicates only: hash the bit patterns.
         let mut seen: HashMap<[u64; 3], u32, BuildHasherDefault<MixHasher>> = HashMap::default();
+        seen.reserve(positions.len() / 2);
         for p in positions {
             let key = [bits(p.x), bits(p.y), bits(p.z)];
             let id = *seen.entry(key).or_insert_with(|| {
@@ -31,7 +32,16 @@ pub fn weld(positions: &[DVec3], tol: f64) -> (Vec<DVec3>, Vec<u32>) {
         }
         return (reps, map);
     }
-    let inv = 1.0 / tol;
+    // Exact duplicates first (an unwelded STL repeats every vertex about six times), then the
+    // tolerance search over the distinct points only.
+    let (uniq, first_map) = weld(positions, 0.0);
+    if uniq.len() < positions.len() {
+        let (reps, m2) = weld(&uniq, tol);
+        return (reps, first_map.into_iter().map(|i| m2[i as usize]).collect());
+    }
+    // Cells four tolerances wide: a point needs the neighbouring cell along an axis only within
+    // one tolerance (a quarter cell) of that face.
+    let inv = 1.0 / (4.0 * tol);
     let tol2 = tol * tol;
     // Cell -> first representative in it; `next` chains representatives of the same cell.
     let mut heads: HashMap<[i64; 3], u32, BuildHasherDefault<MixHasher>> = HashMap::default();

@@ -8,21 +8,17 @@
 //! The mesh's own boundary loops are indexed the same way, for fast "far from any edge" tests.
 
 use glam::DVec3;
-use kiddo::immutable::float::kdtree::ImmutableKdTree;
-use kiddo::SquaredEuclidean;
+use rstar::{PointDistance, RTree, RTreeObject, AABB};
 use towpath_geom::Mesh;
 
 /// A set of closed polylines with nearest-segment queries.
 #[derive(Debug)]
 pub struct Loops {
     /// Segment end points (a, b) and the outward unit normal of the segment in the tangent plane.
-    segs: Vec<Seg>,
-    tree: Option<ImmutableKdTree<f64, u32, 3, 32>>,
-    /// Longest segment (queries look this far beyond the nearest midpoint).
-    max_len: f64,
+    tree: RTree<Seg>,
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 struct Seg {
     a: DVec3,
     b: DVec3,
@@ -33,12 +29,28 @@ struct Seg {
     out_next: DVec3,
 }
 
+impl RTreeObject for Seg {
+    type Envelope = AABB<[f64; 3]>;
+    fn envelope(&self) -> Self::Envelope {
+        AABB::from_corners(self.a.min(self.b).to_array(), self.a.max(self.b).to_array())
+    }
+}
+
+impl PointDistance for Seg {
+    fn distance_2(&self, q: &[f64; 3]) -> f64 {
+        let q = DVec3::from(*q);
+        let ab = self.b - self.a;
+        let l2 = ab.length_squared();
+        let t = if l2 > 0.0 { ((q - self.a).dot(ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+        (self.a + ab * t).distance_squared(q)
+    }
+}
+
 impl Loops {
     /// Closed loops given as point lists with normals (interior on the left of the direction of
     /// travel, looking down the normal).
     pub fn new(loops: &[Vec<(DVec3, DVec3)>]) -> Loops {
         let mut segs = Vec::new();
-        let mut max_len: f64 = 0.0;
         for lp in loops {
             let n = lp.len();
             if n < 2 {
@@ -55,55 +67,38 @@ impl Loops {
             for i in 0..n {
                 let a = lp[i].0;
                 let b = lp[(i + 1) % n].0;
-                max_len = max_len.max(a.distance(b));
                 segs.push(Seg { a, b, out: outs[i], out_prev: outs[(i + n - 1) % n], out_next: outs[(i + 1) % n] });
             }
         }
-        let mids: Vec<[f64; 3]> = segs.iter().map(|s| ((s.a + s.b) * 0.5).to_array()).collect();
-        let tree = (!mids.is_empty()).then(|| ImmutableKdTree::new_from_slice(&mids));
-        Loops { segs, tree, max_len }
+        Loops { tree: RTree::bulk_load(segs) }
     }
 
     /// Whether there are no segments.
     pub fn is_empty(&self) -> bool {
-        self.segs.is_empty()
+        self.tree.size() == 0
     }
 
     /// Signed distance of `q` to the loops: positive inside (left of the loops), negative outside;
     /// +∞ when there are no loops.
     pub fn signed_distance(&self, q: DVec3) -> f64 {
-        let Some(tree) = &self.tree else { return f64::INFINITY };
-        let nn = tree.nearest_n::<SquaredEuclidean>(&q.to_array(), 8.min(self.segs.len()));
-        let Some(first) = nn.first() else { return f64::INFINITY };
-        // Any segment closer than the nearest midpoint's distance has its midpoint within
-        // that distance plus half the longest segment.
-        let reach = first.distance.sqrt() + 0.5 * self.max_len;
-        let cands: Vec<u32> = if nn.len() == self.segs.len() || nn.last().is_some_and(|x| x.distance.sqrt() >= reach) {
-            nn.iter().map(|x| x.item).collect()
+        let Some(s) = self.tree.nearest_neighbor(&q.to_array()) else { return f64::INFINITY };
+        let ab = s.b - s.a;
+        let l2 = ab.length_squared();
+        let t = if l2 > 0.0 { ((q - s.a).dot(ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+        let foot = s.a + ab * t;
+        let out = if t <= 0.0 {
+            (s.out + s.out_prev).normalize_or_zero()
+        } else if t >= 1.0 {
+            (s.out + s.out_next).normalize_or_zero()
         } else {
-            tree.within_unsorted::<SquaredEuclidean>(&q.to_array(), reach * reach).iter().map(|x| x.item).collect()
+            s.out
         };
-        let mut best = (f64::INFINITY, 0.0);
-        for k in cands {
-            let s = &self.segs[k as usize];
-            let ab = s.b - s.a;
-            let l2 = ab.length_squared();
-            let t = if l2 > 0.0 { ((q - s.a).dot(ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
-            let foot = s.a + ab * t;
-            let d = foot.distance(q);
-            if d < best.0 - 1e-12 {
-                let out = if t <= 0.0 {
-                    (s.out + s.out_prev).normalize_or_zero()
-                } else if t >= 1.0 {
-                    (s.out + s.out_next).normalize_or_zero()
-                } else {
-                    s.out
-                };
-                let side = (q - foot).dot(out);
-                best = (d, if side > 0.0 { -1.0 } else { 1.0 });
-            }
+        let d = foot.distance(q);
+        if (q - foot).dot(out) > 0.0 {
+            -d
+        } else {
+            d
         }
-        best.0 * best.1
     }
 
     /// Unsigned distance to the nearest segment (+∞ when empty).

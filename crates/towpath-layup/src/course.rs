@@ -4,7 +4,9 @@
 use glam::DVec3;
 use serde::Serialize;
 
-use crate::trace::PathPoint;
+use towpath_geom::{Mesh, SurfacePoint, NO_FACE};
+
+use crate::trace::{Located, PathPoint};
 
 /// One course of a ply.
 #[derive(Debug, Clone, Serialize)]
@@ -96,6 +98,25 @@ pub struct TowEvent {
     pub restart: u64,
     /// Tows cut here.
     pub cut: u64,
+}
+
+/// The face hint of the segment containing arc length `s` ([`NO_FACE`] if unknown).
+pub fn face_hint(points: &[PathPoint], s: f64) -> u32 {
+    let i = points.partition_point(|q| q.s < s).clamp(1, points.len().max(1));
+    points.get(i.min(points.len().saturating_sub(1))).map_or(NO_FACE, |q| q.face)
+}
+
+/// Locates `p` on the mesh: in face `hint` when `p` projects inside it, else by the closest point.
+pub fn locate(mesh: &Mesh, p: DVec3, hint: u32) -> Option<Located> {
+    if (hint as usize) < mesh.num_faces() {
+        let b = mesh.barycentric(hint, p);
+        if b.min_element() >= -1e-9 {
+            let b = b.max(DVec3::ZERO);
+            let b = b / (b.x + b.y + b.z);
+            return Some(Located::new(mesh, SurfacePoint { face: hint, bary: b }));
+        }
+    }
+    mesh.closest_point(p).map(|sp| Located::new(mesh, sp))
 }
 
 /// Interpolated frame on a polyline of path points at arc length `s` (clamped).

@@ -74,6 +74,7 @@ struct Summary<'a> {
     n2: usize,
     n_estimate: [usize; 2],
     seconds: f64,
+    timings: crate::ply::Timings,
     #[serde(flatten)]
     quality: QualitySummary<'a>,
 }
@@ -109,6 +110,7 @@ pub fn summary(ply: &Ply) -> serde_json::Value {
         n2: ply.n2,
         n_estimate: ply.n_estimate,
         seconds: ply.seconds,
+        timings: ply.timings,
         quality: quality_summary(&ply.quality),
     })
     .unwrap_or(serde_json::Value::Null)

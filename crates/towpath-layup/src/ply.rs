@@ -4,6 +4,8 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use towpath_geom::Mesh;
@@ -13,7 +15,8 @@ use crate::course::Course;
 use crate::field::DirectionField;
 use crate::quality::{self, PlyQuality};
 use crate::section::{Band, Coverage, Sectioner};
-use crate::trace::{tangent, transport, walk, Located, PathPoint, Steering, Stop, WalkOptions};
+use crate::trace::{reverse_walk, tangent, transport, walk, Located, PathPoint, Steering, Stop, WalkOptions};
+use towpath_geom::NO_FACE;
 
 /// How courses follow the design.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -89,6 +92,19 @@ pub struct Ply {
     pub quality: PlyQuality,
     /// Time spent planning (s).
     pub seconds: f64,
+    /// Where the time went (s): centreline tracing, trimming, quality.
+    pub timings: Timings,
+}
+
+/// Time per phase of [`plan`], seconds.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct Timings {
+    /// Tracing and offsetting centrelines.
+    pub courses: f64,
+    /// Per-tow trimming.
+    pub trim: f64,
+    /// Quality figures.
+    pub quality: f64,
 }
 
 /// Errors of ply planning.
@@ -136,6 +152,8 @@ pub fn plan(
     if mesh.num_faces() == 0 {
         return Err(PlyError::Empty);
     }
+    let mut timings = Timings::default();
+    let tp = Instant::now();
     let (lo, hi) = mesh.bounds();
     let diag = (hi - lo).length();
     let mut pl = Planner { mesh, field, region, spec, grid: Default::default(), max_len: 3.0 * diag };
@@ -182,22 +200,35 @@ pub fn plan(
     for (i, c) in left.into_iter().enumerate() {
         lines.push((1, i + 1, c));
     }
+    timings.courses = tp.elapsed().as_secs_f64();
+    let tp = Instant::now();
     let sectioner = Sectioner { mesh, region, band: spec.band() };
-    let mut courses = Vec::with_capacity(lines.len());
-    for (side, offset_index, pts) in lines {
-        let (pts, on_surface) = pl.run_out(pts);
-        let tows = sectioner.trim(&pts, spec.coverage, spec.station_step, 0.01);
-        let mut c = Course { id: 0, side, offset_index, points: pts, on_surface, tows };
-        crop(&mut c);
-        if c.laid_range().is_some() {
-            courses.push(c);
-        }
-    }
+    // Courses are trimmed independently (in parallel; the result does not depend on threads).
+    let prepared: Vec<(i8, usize, Vec<PathPoint>, Vec<bool>)> = lines
+        .into_iter()
+        .map(|(side, offset_index, pts)| {
+            let (pts, on) = pl.run_out(pts);
+            (side, offset_index, pts, on)
+        })
+        .collect();
+    let mut courses: Vec<Course> = prepared
+        .into_par_iter()
+        .map(|(side, offset_index, pts, on_surface)| {
+            let tows = sectioner.trim(&pts, spec.coverage, spec.station_step, 0.01);
+            let mut c = Course { id: 0, side, offset_index, points: pts, on_surface, tows };
+            crop(&mut c);
+            c
+        })
+        .collect();
+    courses.retain(|c| c.laid_range().is_some());
     for (i, c) in courses.iter_mut().enumerate() {
         c.id = i;
     }
+    timings.trim = tp.elapsed().as_secs_f64();
+    let tp = Instant::now();
     let quality = quality::assess(mesh, field, region, spec, &courses);
-    Ok(Ply { courses, n1, n2, n_estimate, quality, seconds: t0.elapsed().as_secs_f64() })
+    timings.quality = tp.elapsed().as_secs_f64();
+    Ok(Ply { courses, n1, n2, n_estimate, quality, seconds: t0.elapsed().as_secs_f64(), timings })
 }
 
 /// The mesh (or ply) point nearest the area centroid.
@@ -295,10 +326,9 @@ impl Planner<'_> {
         };
         let total_b = bwd.last().map_or(0.0, |q| q.s);
         let mut pts = Vec::with_capacity(fwd.len() + bwd.len() + 1);
-        for q in bwd.iter().rev() {
-            pts.push(PathPoint { s: total_b - q.s, d: -q.d, ..*q });
-        }
-        pts.push(PathPoint { p: start.p, n: start.n, d: d_start, s: total_b, face: start.sp.face });
+        pts.extend(reverse_walk(&bwd, start.sp.face).into_iter().map(|q| PathPoint { s: total_b - q.s, ..q }));
+        let start_face = bwd.first().map_or(start.sp.face, |q| q.face);
+        pts.push(PathPoint { p: start.p, n: start.n, d: d_start, s: total_b, face: start_face });
         for q in &fwd {
             pts.push(PathPoint { s: total_b + q.s, ..*q });
         }
@@ -306,19 +336,31 @@ impl Planner<'_> {
     }
 
     /// Walks `dist` along the surface from a course point, perpendicular to the fiber, towards
-    /// `sign` (+1 left). Returns the end located point and the transported fiber direction.
+    /// `sign` (+1 left). Returns the end located point and the transported fiber direction. When
+    /// the mesh ends first but more than half a tow of surface is left beyond the previous
+    /// course's edge, the point a quarter tow inside the mesh edge is returned instead (the last
+    /// course is shifted onto the surface; the overlap this makes is reported by the quality
+    /// figures).
     fn across(&self, at: &PathPoint, sign: f64, dist: f64) -> Option<(Located, DVec3)> {
-        let sp = self.mesh.closest_point(at.p)?;
-        let start = Located::new(self.mesh, sp);
+        let start = crate::course::locate(self.mesh, at.p, at.face)?;
         let b = start.n.cross(at.d) * sign;
         let opts = WalkOptions { max_length: dist, midpoint: true };
-        let (w, stop) = walk(self.mesh, start, b, Steering::Geodesic, &opts, |_| false);
+        let (mut w, stop) = walk(self.mesh, start, b, Steering::Geodesic, &opts, |_| false);
         if stop != Stop::Length {
-            return None;
+            let reach = w.last().map_or(0.0, |q| q.s);
+            let tw = self.spec.tow_width;
+            if stop != Stop::Boundary || reach < 0.5 * dist + 0.5 * tw {
+                return None;
+            }
+            let opts = WalkOptions { max_length: reach - 0.25 * tw, midpoint: true };
+            let (w2, stop2) = walk(self.mesh, start, b, Steering::Geodesic, &opts, |_| false);
+            if stop2 != Stop::Length {
+                return None;
+            }
+            w = w2;
         }
         let end = w.last()?;
-        let sp = self.mesh.closest_point(end.p)?;
-        let loc = Located::new(self.mesh, sp);
+        let loc = crate::course::locate(self.mesh, end.p, end.face)?;
         let d = tangent(transport(at.d, start.n, loc.n), loc.n)?;
         Some((loc, d))
     }
@@ -339,7 +381,7 @@ impl Planner<'_> {
             if !self.useful(p) {
                 continue;
             }
-            let at = PathPoint { p, n, d, s, face: 0 };
+            let at = PathPoint { p, n, d, s, face: crate::course::face_hint(prev, s) };
             let Some((loc, dt)) = self.across(&at, sign, w) else { continue };
             if !self.useful(loc.p) || self.near_existing(loc.p) < 0.5 * w {
                 continue;
@@ -371,7 +413,7 @@ impl Planner<'_> {
         for i in 0..=count {
             let s = (i as f64 * step).min(len);
             let (p, n, d) = crate::course::frame_at(prev, s);
-            let at = PathPoint { p, n, d, s, face: 0 };
+            let at = PathPoint { p, n, d, s, face: crate::course::face_hint(prev, s) };
             let Some((loc, dt)) = self.across(&at, sign, w) else { continue };
             // Drop points where the offset folds back (prev curves tighter than w on this side).
             if let Some(last) = pts.last() {
@@ -379,7 +421,7 @@ impl Planner<'_> {
                     continue;
                 }
             }
-            pts.push(PathPoint { p: loc.p, n: loc.n, d: dt, s: 0.0, face: loc.sp.face });
+            pts.push(PathPoint { p: loc.p, n: loc.n, d: dt, s: 0.0, face: NO_FACE });
         }
         let useful = pts.iter().filter(|q| self.useful(q.p)).count();
         if useful == 0 {
@@ -392,15 +434,17 @@ impl Planner<'_> {
         // Extend both ends geodesically until leaving the ply or the mesh.
         let opts = WalkOptions { max_length: self.max_len, midpoint: true };
         let ext = |q: &PathPoint, dir: DVec3| -> Vec<PathPoint> {
-            let Some(sp) = self.mesh.closest_point(q.p) else { return Vec::new() };
-            let loc = Located::new(self.mesh, sp);
+            let Some(loc) = crate::course::locate(self.mesh, q.p, q.face) else { return Vec::new() };
             walk(self.mesh, loc, dir, Steering::Geodesic, &opts, |x| self.outside_far(x.p)).0
         };
         let first = *pts.first()?;
         let last = *pts.last()?;
         let head = ext(&first, -first.d);
         let tail = ext(&last, last.d);
-        let mut all: Vec<PathPoint> = head.iter().rev().map(|q| PathPoint { d: -q.d, ..*q }).collect();
+        let mut all: Vec<PathPoint> = reverse_walk(&head, NO_FACE);
+        if let Some(first) = pts.first_mut() {
+            first.face = head.first().map_or(NO_FACE, |q| q.face);
+        }
         all.extend(pts);
         all.extend(tail);
         let mut s = 0.0;
@@ -428,7 +472,7 @@ impl Planner<'_> {
             if near_edge(l.p) {
                 for i in 1..=k {
                     let t = w * i as f64 / k as f64;
-                    pts.push(PathPoint { p: l.p + l.d * t, s: l.s + t, ..l });
+                    pts.push(PathPoint { p: l.p + l.d * t, s: l.s + t, face: NO_FACE, ..l });
                     on.push(false);
                 }
             }
@@ -438,9 +482,12 @@ impl Planner<'_> {
                 let mut head = Vec::new();
                 for i in (1..=k).rev() {
                     let t = w * i as f64 / k as f64;
-                    head.push(PathPoint { p: f.p - f.d * t, s: f.s - t, ..f });
+                    head.push(PathPoint { p: f.p - f.d * t, s: f.s - t, face: NO_FACE, ..f });
                 }
                 let n = head.len();
+                if let Some(first) = pts.first_mut() {
+                    first.face = NO_FACE;
+                }
                 head.extend(pts);
                 pts = head;
                 let mut on2 = vec![false; n];
@@ -468,8 +515,9 @@ impl Planner<'_> {
             if self.region.has_curve() && self.region.curve_distance(p) < 0.0 {
                 continue;
             }
-            let Some(sp) = self.mesh.closest_point(p) else { continue };
-            let start = Located::new(self.mesh, sp);
+            let Some(start) = crate::course::locate(self.mesh, p, crate::course::face_hint(reference, s)) else {
+                continue;
+            };
             for (k, sign) in [(0usize, 1.0f64), (1, -1.0)] {
                 let b = n.cross(d) * sign;
                 let opts = WalkOptions {
@@ -485,7 +533,8 @@ impl Planner<'_> {
             }
         }
         // The reference course covers half a width on each side.
-        [((best[0] - 0.5 * w).max(0.0) / w).ceil() as usize, ((best[1] - 0.5 * w).max(0.0) / w).ceil() as usize]
+        let count = |l: f64| ((l - 0.5 * w).max(0.0) / w - 1e-6).ceil().max(0.0) as usize;
+        [count(best[0]), count(best[1])]
     }
 }
 
@@ -494,7 +543,11 @@ fn crop(c: &mut Course) {
     let Some([a, b]) = c.laid_range() else { return };
     let (pa, na, da) = c.frame_at(a);
     let (pb, nb, db) = c.frame_at(b);
-    let mut pts = vec![PathPoint { p: pa, n: na, d: da, s: a, face: 0 }];
+    let face_at = |s: f64| {
+        let i = c.points.partition_point(|q| q.s < s).min(c.points.len().saturating_sub(1));
+        c.points.get(i).map_or(NO_FACE, |q| q.face)
+    };
+    let mut pts = vec![PathPoint { p: pa, n: na, d: da, s: a, face: NO_FACE }];
     let mut on = vec![c.on_surface.get(c.points.partition_point(|q| q.s < a)).copied().unwrap_or(true)];
     for (q, &o) in c.points.iter().zip(&c.on_surface) {
         if q.s > a + 1e-9 && q.s < b - 1e-9 {
@@ -502,7 +555,7 @@ fn crop(c: &mut Course) {
             on.push(o);
         }
     }
-    pts.push(PathPoint { p: pb, n: nb, d: db, s: b, face: 0 });
+    pts.push(PathPoint { p: pb, n: nb, d: db, s: b, face: face_at(b) });
     on.push(
         c.on_surface
             .get(c.points.partition_point(|q| q.s < b).min(c.points.len().saturating_sub(1)))

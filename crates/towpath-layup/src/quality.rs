@@ -4,8 +4,9 @@
 //! gap and overlap areas, minimum steering radius and maximum angle deviation.
 
 use glam::DVec3;
-use kiddo::immutable::float::kdtree::ImmutableKdTree;
-use kiddo::SquaredEuclidean;
+use rayon::prelude::*;
+use rstar::primitives::GeomWithData;
+use rstar::RTree;
 use serde::Serialize;
 use towpath_geom::Mesh;
 
@@ -13,7 +14,7 @@ use crate::boundary::Region;
 use crate::course::Course;
 use crate::field::DirectionField;
 use crate::ply::PlySpec;
-use crate::trace::{walk, Located, PathPoint, Steering, WalkOptions};
+use crate::trace::{walk, PathPoint, Steering, WalkOptions};
 
 /// Per-point figures of one course (same length as its points).
 #[derive(Debug, Clone, Default, Serialize)]
@@ -94,15 +95,17 @@ pub fn course_figures(c: &Course, field: &dyn DirectionField, spec: &PlySpec) ->
     q
 }
 
+type Indexed = GeomWithData<[f64; 3], u32>;
+
 struct Nearest {
-    tree: Option<ImmutableKdTree<f64, u32, 3, 32>>,
+    tree: RTree<Indexed>,
     pts: Vec<PathPoint>,
 }
 
 impl Nearest {
     fn new(pts: &[PathPoint]) -> Nearest {
-        let coords: Vec<[f64; 3]> = pts.iter().map(|q| q.p.to_array()).collect();
-        Nearest { tree: (!coords.is_empty()).then(|| ImmutableKdTree::new_from_slice(&coords)), pts: pts.to_vec() }
+        let items: Vec<Indexed> = pts.iter().enumerate().map(|(i, q)| Indexed::new(q.p.to_array(), i as u32)).collect();
+        Nearest { tree: RTree::bulk_load(items), pts: pts.to_vec() }
     }
     fn length(&self) -> f64 {
         self.pts.last().map_or(0.0, |q| q.s)
@@ -110,8 +113,7 @@ impl Nearest {
 
     /// Foot of perpendicular on the polyline near p: (point, normal, arc length, direction).
     fn foot_frame(&self, p: DVec3) -> Option<(DVec3, DVec3, f64, DVec3)> {
-        let nn = self.tree.as_ref()?.nearest_one::<SquaredEuclidean>(&p.to_array());
-        let i = nn.item as usize;
+        let i = self.tree.nearest_neighbor(&p.to_array())?.data as usize;
         let mut best: Option<(f64, DVec3, DVec3, f64, DVec3)> = None;
         for (a, b) in [(i.saturating_sub(1), i), (i, (i + 1).min(self.pts.len() - 1))] {
             let (qa, qb) = (&self.pts[a], &self.pts[b]);
@@ -134,11 +136,9 @@ impl Nearest {
 /// there. `None` when the walk leaves the mesh or does not cross within `reach`.
 fn spacing_to(mesh: &Mesh, c: &Course, near: &Nearest, s: f64, reach: f64) -> Option<(f64, f64)> {
     let (p, _, d) = c.frame_at(s);
-    let sp = mesh.closest_point(p)?;
-    let start = Located::new(mesh, sp);
+    let start = crate::course::locate(mesh, p, crate::course::face_hint(&c.points, s))?;
     let b = start.n.cross(d);
     let opts = WalkOptions { max_length: reach, midpoint: true };
-    let (w, _) = walk(mesh, start, b, Steering::Geodesic, &opts, |_| false);
     // Side of x relative to the neighbour: > 0 left of it.
     let side = |x: DVec3| -> Option<(f64, f64)> {
         let (f, n, sf, dir) = near.foot_frame(x)?;
@@ -152,17 +152,32 @@ fn spacing_to(mesh: &Mesh, c: &Course, near: &Nearest, s: f64, reach: f64) -> Op
     if prev_side >= 0.0 {
         return None; // not to the right of the neighbour: not its left neighbour here
     }
+    // The chord to the neighbour bounds where the crossing can be: test sides only from there on.
+    let chord = near.foot_frame(start.p).map_or(0.0, |f| f.0.distance(start.p));
+    let (w, _) = walk(mesh, start, b, Steering::Geodesic, &opts, |q| {
+        q.s >= 0.9 * chord && side(q.p).is_none_or(|(sd, _)| sd >= 0.0)
+    });
     let mut prev_s = 0.0;
+    let mut prev_known = true;
     for q in &w {
+        if q.s < 0.9 * chord {
+            prev_x = q.p;
+            prev_s = q.s;
+            prev_known = false;
+            continue;
+        }
         let (sd, sf) = side(q.p)?;
         if sd >= 0.0 {
-            let t = prev_side / (prev_side - sd);
-            let _ = prev_x;
+            if !prev_known {
+                prev_side = side(prev_x)?.0;
+            }
+            let t = if prev_side < 0.0 { prev_side / (prev_side - sd) } else { 0.0 };
             return Some((prev_s + t * (q.s - prev_s), sf));
         }
         prev_x = q.p;
         prev_side = sd;
         prev_s = q.s;
+        prev_known = true;
     }
     None
 }
@@ -215,23 +230,32 @@ pub fn assess(
     if courses.len() > 2 {
         pairs.push((courses.len() - 1, 0));
     }
-    for (i, j) in pairs {
-        let (c, nb) = (&courses[i], &courses[j]);
-        let near = Nearest::new(&nb.points);
-        let len = c.length();
-        let count = (len / step).ceil() as usize;
-        let ds = len / count.max(1) as f64;
-        for k in 0..=count {
-            let s = len * k as f64 / count.max(1) as f64;
-            if !c.laid(nt - 1, s) || !c.on_surface_at(s) {
-                continue;
+    let per_pair: Vec<(usize, Vec<[f64; 2]>, f64)> = pairs
+        .par_iter()
+        .map(|&(i, j)| {
+            let (c, nb) = (&courses[i], &courses[j]);
+            let near = Nearest::new(&nb.points);
+            let len = c.length();
+            let count = (len / step).ceil() as usize;
+            let ds = len / count.max(1) as f64;
+            let mut out = Vec::new();
+            for k in 0..=count {
+                let s = len * k as f64 / count.max(1) as f64;
+                if !c.laid(nt - 1, s) || !c.on_surface_at(s) {
+                    continue;
+                }
+                let Some((spacing, sf)) = spacing_to(mesh, c, &near, s, 1.5 * w) else { continue };
+                if !nb.laid(0, sf) || !nb.on_surface_at(sf) {
+                    continue;
+                }
+                out.push([s, spacing - w]);
             }
-            let Some((spacing, sf)) = spacing_to(mesh, c, &near, s, 2.0 * w) else { continue };
-            if !nb.laid(0, sf) || !nb.on_surface_at(sf) {
-                continue;
-            }
-            let width = spacing - w;
-            pq.courses[i].gap_to_left.push([s, width]);
+            (i, out, ds)
+        })
+        .collect();
+    for (i, widths, ds) in per_pair {
+        for &[s, width] in &widths {
+            let _ = s;
             if width > 0.0 {
                 pq.gap_area += width * ds;
                 pq.max_gap = pq.max_gap.max(width);
@@ -240,59 +264,40 @@ pub fn assess(
                 pq.max_overlap = pq.max_overlap.max(-width);
             }
         }
+        pq.courses[i].gap_to_left.extend(widths);
     }
     // Coverage: area-weighted face-centroid samples inside the ply, each checked against the laid
     // tows of the nearest course stations.
     let mut stations: Vec<(usize, f64)> = Vec::new();
-    let mut coords: Vec<[f64; 3]> = Vec::new();
+    let mut items: Vec<Indexed> = Vec::new();
     let sstep = (0.25 * w).clamp(1.0, 10.0);
     for (ci, c) in courses.iter().enumerate() {
         let len = c.length();
         let count = (len / sstep).ceil().max(1.0) as usize;
         for j in 0..=count {
             let s = len * j as f64 / count as f64;
+            items.push(Indexed::new(c.frame_at(s).0.to_array(), stations.len() as u32));
             stations.push((ci, s));
-            coords.push(c.frame_at(s).0.to_array());
         }
     }
-    let tree = (!coords.is_empty()).then(|| ImmutableKdTree::<f64, u32, 3, 32>::new_from_slice(&coords));
+    let tree = RTree::bulk_load(items);
     let nf = mesh.num_faces();
-    let stride = (nf / 60_000).max(1);
+    let stride = (nf / 20_000).max(1);
+    let samples: Vec<u32> = (0..nf).step_by(stride).map(|f| f as u32).collect();
+    let hits: Vec<(f64, bool)> = samples
+        .par_iter()
+        .filter_map(|&f| {
+            let c = mesh.corners(f);
+            let x = (c[0] + c[1] + c[2]) / 3.0;
+            if region.has_curve() && region.curve_distance(x) < 0.0 {
+                return None;
+            }
+            Some((mesh.face_area(f), covered_point(&tree, &stations, courses, x, sstep, spec)))
+        })
+        .collect();
     let (mut area, mut covered) = (0.0, 0.0);
-    for f in (0..nf).step_by(stride) {
-        let f = f as u32;
-        let c = mesh.corners(f);
-        let x = (c[0] + c[1] + c[2]) / 3.0;
-        if region.has_curve() && region.curve_distance(x) < 0.0 {
-            continue;
-        }
-        let a = mesh.face_area(f);
+    for (a, hit) in hits {
         area += a;
-        let Some(tree) = &tree else { continue };
-        let mut hit = false;
-        for nn in tree.nearest_n::<SquaredEuclidean>(&x.to_array(), 6) {
-            let (ci, s) = stations[nn.item as usize];
-            let cr = &courses[ci];
-            let (p, n, d) = cr.frame_at(s);
-            let v = x - p;
-            let along = v.dot(d);
-            if along.abs() > 0.5 * sstep + 1e-9 {
-                // Slide to the foot along the course.
-                let (p2, n2, d2) = cr.frame_at(s + along);
-                let v2 = x - p2;
-                let o = v2.dot(n2.cross(d2));
-                if covered_by(cr, o, s + along, spec) && v2.dot(d2).abs() <= 0.5 * sstep {
-                    hit = true;
-                    break;
-                }
-                continue;
-            }
-            let o = v.dot(n.cross(d));
-            if covered_by(cr, o, s, spec) {
-                hit = true;
-                break;
-            }
-        }
         if hit {
             covered += a;
         }
@@ -300,6 +305,34 @@ pub fn assess(
     pq.ply_area = area * stride as f64;
     pq.coverage_percent = if area > 0.0 { 100.0 * covered / area } else { 0.0 };
     pq
+}
+
+/// Whether point x is under a laid tow of one of the nearest course stations.
+fn covered_point(
+    tree: &RTree<Indexed>,
+    stations: &[(usize, f64)],
+    courses: &[Course],
+    x: DVec3,
+    sstep: f64,
+    spec: &PlySpec,
+) -> bool {
+    for nn in tree.nearest_neighbor_iter(&x.to_array()).take(6) {
+        let (ci, s) = stations[nn.data as usize];
+        let cr = &courses[ci];
+        let (p, _, d) = cr.frame_at(s);
+        // Slide to the foot of the perpendicular along the course.
+        let along = (x - p).dot(d);
+        let sf = s + along;
+        let (p2, n2, d2) = cr.frame_at(sf);
+        let v2 = x - p2;
+        if v2.dot(d2).abs() > 0.5 * sstep + 1e-9 {
+            continue;
+        }
+        if covered_by(cr, v2.dot(n2.cross(d2)), sf, spec) {
+            return true;
+        }
+    }
+    false
 }
 
 fn covered_by(c: &Course, lateral: f64, s: f64, spec: &PlySpec) -> bool {

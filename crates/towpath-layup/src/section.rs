@@ -13,8 +13,8 @@ use serde::{Deserialize, Serialize};
 use towpath_geom::Mesh;
 
 use crate::boundary::Region;
-use crate::course::frame_at;
-use crate::trace::{walk, Located, PathPoint, Steering, Stop, WalkOptions};
+use crate::course::{face_hint, frame_at, locate};
+use crate::trace::{walk, PathPoint, Steering, Stop, WalkOptions};
 
 /// Where a tow is cut (and restarted) at the ply boundary: the 0 % / 50 % / 100 % coverage
 /// conventions of AFP programming tools.
@@ -112,60 +112,80 @@ impl Sectioner<'_> {
         !self.region.has_curve() || self.region.curve_distance(q) >= 0.0
     }
 
-    /// Whether a point (possibly off the mesh) lies on the mesh rather than beyond its boundary:
-    /// its offset from the closest mesh point is (nearly) along the face normal.
+    /// Whether a point near the mesh edge (possibly off the surface) lies over the mesh rather than
+    /// beyond its boundary: the side of the nearest mesh boundary edge (interior on the left).
     fn on_mesh(&self, q: DVec3) -> bool {
-        let Some(sp) = self.mesh.closest_point(q) else { return false };
-        let v = q - self.mesh.point(sp);
-        let nf = self.mesh.face_normal(sp.face);
-        (v - nf * v.dot(nf)).length() <= 1e-3 * self.band.tow_width
+        self.region.mesh_edges.signed_distance(q) >= 0.0
     }
 
     /// The cross section at arc length `s` of `points`.
     pub fn section(&self, points: &[PathPoint], s: f64) -> Section {
-        let (p, n, d) = frame_at(points, s);
         let nt = self.band.tows;
-        let all = |v: bool| Section { edges: vec![v; nt + 1], centres: vec![v; nt] };
+        let offsets: Vec<f64> =
+            (0..=nt).map(|j| self.band.edge(j)).chain((0..nt).map(|k| self.band.centre(k))).collect();
+        let inside = self.lines(points, s, &offsets);
+        Section { edges: inside[..=nt].to_vec(), centres: inside[nt + 1..].to_vec() }
+    }
+
+    /// Whether tow `k` is laid at `s` under `rule` (its two edges and centre only).
+    pub fn tow_laid(&self, points: &[PathPoint], s: f64, k: usize, rule: Coverage) -> bool {
+        let offsets = [self.band.edge(k), self.band.centre(k), self.band.edge(k + 1)];
+        let v = self.lines(points, s, &offsets);
+        match rule {
+            Coverage::Zero => v[0] && v[1] && v[2],
+            Coverage::Half => v[1],
+            Coverage::Full => v[0] || v[1] || v[2],
+        }
+    }
+
+    /// Inside flags of the lines at lateral `offsets` (left positive) at arc length `s`.
+    pub fn lines(&self, points: &[PathPoint], s: f64, offsets: &[f64]) -> Vec<bool> {
+        let (p, n, d) = frame_at(points, s);
         let half = 0.5 * self.band.width();
         let margin = half + self.band.tow_width;
         let sd = self.region.curve_distance(p);
         if sd < -margin {
-            return all(false);
+            return vec![false; offsets.len()];
         }
-        let located = self.mesh.closest_point(p).map(|sp| Located::new(self.mesh, sp));
+        let hint = face_hint(points, s);
+        // A run-out point (no face) beyond the mesh edge needs no projection.
+        let located = if hint == towpath_geom::NO_FACE && !self.on_mesh(p) { None } else { locate(self.mesh, p, hint) };
         let centre_on_mesh = located.is_some_and(|l| {
             let v = p - l.p;
             let nf = self.mesh.face_normal(l.sp.face);
             (v - nf * v.dot(nf)).length() <= 1e-3 * self.band.tow_width
         });
-        let dm = self.region.mesh_edges.distance(p);
-        if centre_on_mesh && sd > margin && dm > margin {
-            return all(true);
+        if centre_on_mesh && sd > margin && self.region.mesh_edges.distance(p) > margin {
+            return vec![true; offsets.len()];
         }
         let b = n.cross(d).normalize_or_zero();
-        let offsets: Vec<f64> =
-            (0..=nt).map(|j| self.band.edge(j)).chain((0..nt).map(|k| self.band.centre(k))).collect();
         let mut inside = vec![false; offsets.len()];
         match located {
             Some(start) if centre_on_mesh => {
-                // Geodesic walks to both sides, reaching just past the outer edges.
-                let opts = WalkOptions { max_length: half + 1e-9, midpoint: true };
-                let (left, stop_l) = walk(self.mesh, start, b, Steering::Geodesic, &opts, |_| false);
-                let (right, stop_r) = walk(self.mesh, start, -b, Steering::Geodesic, &opts, |_| false);
+                // Geodesic walks to each side that has lines, just past the outermost one.
+                let reach_l = offsets.iter().fold(0.0f64, |m, &o| m.max(o));
+                let reach_r = offsets.iter().fold(0.0f64, |m, &o| m.max(-o));
+                let side = |dir: DVec3, reach: f64| {
+                    if reach <= 0.0 {
+                        return (Vec::new(), Stop::Length);
+                    }
+                    let opts = WalkOptions { max_length: reach + 1e-9, midpoint: true };
+                    walk(self.mesh, start, dir, Steering::Geodesic, &opts, |_| false)
+                };
+                let (left, stop_l) = side(b, reach_l);
+                let (right, stop_r) = side(-b, reach_r);
                 for (i, &o) in offsets.iter().enumerate() {
                     let (w, stop) = if o >= 0.0 { (&left, stop_l) } else { (&right, stop_r) };
                     let a = o.abs();
-                    let reach = w.last().map_or(0.0, |q| q.s);
                     if a <= 1e-12 {
                         inside[i] = self.inside_curve(start.p);
                         continue;
                     }
+                    let reach = w.last().map_or(0.0, |q| q.s);
                     if reach + 1e-9 < a && stop != Stop::Length {
-                        inside[i] = false; // the mesh ends before this line
-                        continue;
+                        continue; // the mesh ends before this line
                     }
-                    let q = point_at(start.p, w, a);
-                    inside[i] = self.inside_curve(q);
+                    inside[i] = self.inside_curve(point_at(start.p, w, a));
                 }
             }
             _ => {
@@ -176,7 +196,7 @@ impl Sectioner<'_> {
                 }
             }
         }
-        Section { edges: inside[..=nt].to_vec(), centres: inside[nt + 1..].to_vec() }
+        inside
     }
 
     /// Laid intervals per tow along `points` (stations every `step`, transitions refined by
@@ -245,7 +265,7 @@ impl Sectioner<'_> {
     ) -> f64 {
         while b - a > tol {
             let m = 0.5 * (a + b);
-            if self.section(points, m).laid(k, rule) == laid_at_a {
+            if self.tow_laid(points, m, k, rule) == laid_at_a {
                 a = m;
             } else {
                 b = m;

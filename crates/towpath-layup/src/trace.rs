@@ -39,7 +39,8 @@ pub struct PathPoint {
     pub d: DVec3,
     /// Arc length from the path's first point.
     pub s: f64,
-    /// The face the point lies on (for edge crossings: the face the path leaves).
+    /// A face the point lies on; along a traced path, the face of the segment ending at this
+    /// point ([`NO_FACE`] where unknown).
     #[serde(skip)]
     pub face: u32,
 }
@@ -271,6 +272,19 @@ pub fn walk(
     (out, Stop::Stuck)
 }
 
+/// Reverses a walk (points after the start) for prepending: directions flipped and each point's
+/// face made the face of the segment that leads *to* it in the reversed order, so that along a
+/// path the segment from point i to point i + 1 always lies in point i + 1's face.
+pub fn reverse_walk(w: &[PathPoint], start_face: u32) -> Vec<PathPoint> {
+    let mut out = Vec::with_capacity(w.len());
+    for j in (0..w.len()).rev() {
+        let face = if j + 1 < w.len() { w[j + 1].face } else { w[j].face };
+        out.push(PathPoint { d: -w[j].d, face, ..w[j] });
+    }
+    let _ = start_face;
+    out
+}
+
 /// A path traced in both directions from a start point.
 #[derive(Debug, Clone, Serialize)]
 pub struct Path {
@@ -314,11 +328,11 @@ pub fn trace_both(
     let (bwd, stop_b) = walk(mesh, start, -d_start, steering, opts, &mut stop);
     let mut points = Vec::with_capacity(fwd.len() + bwd.len() + 1);
     let total_b = bwd.last().map_or(0.0, |q| q.s);
-    for q in bwd.iter().rev() {
-        points.push(PathPoint { s: total_b - q.s, d: -q.d, ..*q });
-    }
+    let rev = reverse_walk(&bwd, start.sp.face);
+    points.extend(rev.iter().map(|q| PathPoint { s: total_b - q.s, ..*q }));
     let start_index = points.len();
-    points.push(PathPoint { p: start.p, n: start.n, d: d_start, s: total_b, face: start.sp.face });
+    let start_face = bwd.first().map_or(start.sp.face, |q| q.face);
+    points.push(PathPoint { p: start.p, n: start.n, d: d_start, s: total_b, face: start_face });
     for q in &fwd {
         points.push(PathPoint { s: total_b + q.s, ..*q });
     }

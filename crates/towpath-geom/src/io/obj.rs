@@ -19,7 +19,7 @@ pub fn read_obj(bytes: &[u8]) -> Result<Soup, MeshError> {
         let nv = mesh.positions.len() / 3;
         for k in 0..nv {
             let p = &mesh.positions[3 * k..3 * k + 3];
-            soup.positions.push(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+            soup.positions.push(DVec3::new(p[0], p[1], p[2]));
         }
         let check = |i: u32| -> Result<u32, MeshError> {
             if (i as usize) < nv {

@@ -182,7 +182,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let spinner = progress_bar();
     spinner.set_message(format!("loading {}", args.surface));
+    let tl = Instant::now();
     let loaded = load_surface(&args.surface, tess, args.weld_tolerance)?;
+    let load_seconds = tl.elapsed().as_secs_f64();
     let mesh = &loaded.mesh;
     if let Some(path) = &args.write_mesh {
         io::write_path(path, &mesh.to_soup()).map_err(exit::bad_input)?;
@@ -267,6 +269,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         if let Some(o) = s.as_object_mut() {
             o.insert("mesh_triangles".into(), mesh.num_faces().into());
             o.insert("repair".into(), serde_json::to_value(&loaded.report)?);
+            o.insert("load_seconds".into(), load_seconds.into());
             o.insert("total_seconds".into(), t0.elapsed().as_secs_f64().into());
             o.insert("output".into(), args.output.display().to_string().into());
         }
