@@ -214,7 +214,7 @@ pub fn plan(
     let mut courses: Vec<Course> = prepared
         .into_par_iter()
         .map(|(side, offset_index, pts, on_surface)| {
-            let tows = sectioner.trim(&pts, spec.coverage, spec.station_step, 0.01);
+            let tows = sectioner.trim(&pts, spec.coverage, spec.station_step, 1e-3);
             let mut c = Course { id: 0, side, offset_index, points: pts, on_surface, tows };
             crop(&mut c);
             c

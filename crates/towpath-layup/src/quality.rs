@@ -281,26 +281,59 @@ pub fn assess(
         }
     }
     let tree = RTree::bulk_load(items);
+    // Samples: every face split into m × m sub-triangles (m from the face size and a spacing of
+    // half a tow width, within a budget), one sample at each sub-triangle's centroid.
     let nf = mesh.num_faces();
-    let stride = (nf / 20_000).max(1);
-    let samples: Vec<u32> = (0..nf).step_by(stride).map(|f| f as u32).collect();
-    let hits: Vec<(f64, bool)> = samples
+    let budget = 120_000.0;
+    let mut h = 0.5 * spec.tow_width;
+    let edge_max = |f: u32| {
+        let c = mesh.corners(f);
+        c[0].distance(c[1]).max(c[1].distance(c[2])).max(c[2].distance(c[0]))
+    };
+    let count_at = |h: f64| (0..nf as u32).map(|f| (edge_max(f) / h).ceil().clamp(1.0, 16.0).powi(2)).sum::<f64>();
+    let mut stride = 1usize;
+    while count_at(h) > budget && h < 1e6 {
+        h *= 1.5;
+        if (edge_max(0) / h) < 1.0 && count_at(h) > budget {
+            stride = ((count_at(h) / budget).ceil() as usize).max(1);
+            break;
+        }
+    }
+    let faces: Vec<u32> = (0..nf as u32).step_by(stride).collect();
+    let hits: Vec<(f64, f64)> = faces
         .par_iter()
-        .filter_map(|&f| {
+        .map(|&f| {
             let c = mesh.corners(f);
-            let x = (c[0] + c[1] + c[2]) / 3.0;
-            if region.has_curve() && region.curve_distance(x) < 0.0 {
-                return None;
+            let m = (edge_max(f) / h).ceil().clamp(1.0, 16.0) as usize;
+            let a = mesh.face_area(f) / (m * m) as f64;
+            let (mut area, mut covered) = (0.0, 0.0);
+            for i in 0..m {
+                for j in 0..(m - i) {
+                    // Upward and (where it exists) downward sub-triangle centroids.
+                    let mut pts = vec![(i as f64 + 1.0 / 3.0, j as f64 + 1.0 / 3.0)];
+                    if i + j + 1 < m {
+                        pts.push((i as f64 + 2.0 / 3.0, j as f64 + 2.0 / 3.0));
+                    }
+                    for (u, v) in pts {
+                        let (u, v) = (u / m as f64, v / m as f64);
+                        let x = c[0] * (1.0 - u - v) + c[1] * u + c[2] * v;
+                        if region.has_curve() && region.curve_distance(x) < 0.0 {
+                            continue;
+                        }
+                        area += a;
+                        if covered_point(&tree, &stations, courses, x, sstep, spec) {
+                            covered += a;
+                        }
+                    }
+                }
             }
-            Some((mesh.face_area(f), covered_point(&tree, &stations, courses, x, sstep, spec)))
+            (area, covered)
         })
         .collect();
     let (mut area, mut covered) = (0.0, 0.0);
-    for (a, hit) in hits {
+    for (a, c) in hits {
         area += a;
-        if hit {
-            covered += a;
-        }
+        covered += c;
     }
     pq.ply_area = area * stride as f64;
     pq.coverage_percent = if area > 0.0 { 100.0 * covered / area } else { 0.0 };
