@@ -12,6 +12,9 @@
 //!
 //! The crate knows nothing of fibers, plies or files other than mesh formats.
 
+// `!(a > b)` is used on purpose: it is also true when a or b is NaN, which input checks rely on.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 mod closest;
 mod error;
 pub mod io;

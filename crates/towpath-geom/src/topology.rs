@@ -221,9 +221,7 @@ pub(crate) fn boundary_loops(tris: &[[u32; 3]], neighbors: &[[u32; 3]]) -> Vec<V
         while out_edges.get(&s).is_some_and(|v| !v.is_empty()) {
             let mut lp = vec![s];
             let mut cur = s;
-            loop {
-                let Some(list) = out_edges.get_mut(&cur) else { break };
-                let Some(next) = list.pop() else { break };
+            while let Some(next) = out_edges.get_mut(&cur).and_then(Vec::pop) {
                 if next == s {
                     break;
                 }

@@ -209,6 +209,9 @@ fn obj_polygons_are_fanned_and_bad_indices_refused() {
     let ply = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n";
     let e = io::read_bytes(ply, Format::Ply).unwrap_err().to_string();
     assert!(e.contains("out of range"), "{e}");
+    // Found by fuzzing: a header number too long for u64 made the PLY grammar panic.
+    let crash = b"ply\nformat ascii 9999999999999999999999999999999999999990.0\nelement vertex 1\nproperty float x\nend_header\n0\n";
+    assert!(io::read_bytes(crash, Format::Ply).is_err());
 }
 
 proptest! {

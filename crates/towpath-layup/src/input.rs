@@ -23,11 +23,7 @@ fn rows(text: &str, width: usize) -> Result<Vec<(usize, Vec<f64>)>, CsvError> {
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        let fields: Vec<&str> = line
-            .split(|c: char| c == ',' || c == ';' || c == '\t' || c == ' ')
-            .map(str::trim)
-            .filter(|f| !f.is_empty())
-            .collect();
+        let fields: Vec<&str> = line.split([',', ';', '\t', ' ']).map(str::trim).filter(|f| !f.is_empty()).collect();
         let parsed: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
         let Ok(vals) = parsed else {
             if first_data && out.is_empty() {

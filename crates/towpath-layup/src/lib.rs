@@ -10,6 +10,9 @@
 //! - [`accuracy`]: deviations from closed-form geodesics on analytic surfaces (seed 001 §4).
 //! - [`output`]: courses as JSON, CSV and a G-code program.
 
+// `!(a > b)` is used on purpose: it is also true when a or b is NaN, which input checks rely on.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod accuracy;
 pub mod boundary;
 pub mod course;

@@ -269,8 +269,8 @@ fn axis_words(p: DVec3, r: [f64; 3]) -> String {
 }
 
 /// The ply as a G-code program in the reference dialect: per course an approach above the start
-/// along the normal (G0), contact (G1), roller on (M20), tow restarts (M60 P<mask>) and cuts
-/// (M61 P<mask>) at their positions between feed moves (G1), roller off (M21), a lift along the
+/// along the normal (G0), contact (G1), roller on (M20), tow restarts (`M60 P<mask>`) and cuts
+/// (`M61 P<mask>`) at their positions between feed moves (G1), roller off (M21), a lift along the
 /// normal (G1) and a retract (G0).
 pub fn to_gcode(ply: &Ply, meta: &Meta, post: &Post) -> String {
     let mut g = String::new();

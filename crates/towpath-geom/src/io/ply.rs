@@ -45,6 +45,11 @@ fn check_header_counts(bytes: &[u8]) -> Result<(), MeshError> {
     let head_end = bytes.windows(10).position(|w| w == b"end_header").unwrap_or(bytes.len().min(65536));
     let head = String::from_utf8_lossy(&bytes[..head_end]);
     for (i, line) in head.lines().enumerate() {
+        // The header grammar of ply-rs-bw unwraps integer parses: refuse numbers too long for u64.
+        let longest_digits = line.split(|c: char| !c.is_ascii_digit()).map(str::len).max().unwrap_or(0);
+        if longest_digits > 18 {
+            return Err(err(format!("header line {}: number too large", i + 1)));
+        }
         let mut it = line.split_whitespace();
         if it.next() == Some("element") {
             let _name = it.next();
