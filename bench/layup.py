@@ -183,6 +183,11 @@ def towpath_ply(mesh, repeats, extra):
 
 
 def main():
+    # Run the whole script inside bench/.venv (numpy and potpourri3d live there).
+    venv_py = os.path.join(VENV, "bin", "python")
+    if os.path.realpath(sys.prefix) != os.path.realpath(VENV):
+        py = ensure_venv()
+        os.execv(py, [py, os.path.abspath(__file__)] + sys.argv[1:])
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeats", type=int, default=5)
     args = ap.parse_args()
@@ -190,7 +195,7 @@ def main():
     subprocess.check_call(["cargo", "build", "--release", "-q", "-p", "towpath"], cwd=ROOT)
     subprocess.check_call(["cargo", "run", "--release", "-q", "-p", "towpath-layup", "--example", "layup_bench", "--",
                            OUT, str(args.repeats)], cwd=ROOT)
-    py = ensure_venv()
+    py = venv_py
     load = os.getloadavg()
     pp = pp3d_traces(py, args.repeats)
     lines = [SECTION, "",
