@@ -21,14 +21,14 @@ enum Command {
     Demo(cmd::demo::Args),
     /// Generate the fiber courses of a ply on a mold surface (mesh or analytic), trimmed per tow,
     /// with quality figures; write JSON, CSV and G-code.
-    Layup(cmd::layup::Args),
+    Layup(Box<cmd::layup::Args>),
 }
 
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Demo(args) => cmd::demo::run(args),
-        Command::Layup(args) => cmd::layup::run(args),
+        Command::Layup(args) => cmd::layup::run(*args),
     };
     std::process::exit(exit::report(result));
 }

@@ -207,3 +207,29 @@ fn errors_name_the_input_and_the_problem() {
     assert_eq!(code, Some(2));
     assert!(err.contains("undefined"), "{err}");
 }
+
+#[test]
+fn nurbs_patch_surface_is_tessellated_and_covered() {
+    let d = tmp("nurbs");
+    // A 400 × 300 mm bilinear-in-x, quadratic-in-y patch (a shallow trough).
+    let patch = serde_json::json!({
+        "degree_u": 1, "degree_v": 2,
+        "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 0, 1, 1, 1],
+        "count_u": 2, "count_v": 3,
+        "control": [[0, 0, 40], [0, 150, -40], [0, 300, 40], [400, 0, 40], [400, 150, -40], [400, 300, 40]]
+    });
+    std::fs::write(d.join("patch.json"), patch.to_string()).unwrap();
+    let out = towpath(
+        &d,
+        &["layup", "nurbs:patch.json", "--angle", "0", "--tow-width", "6.35", "--tows", "8", "--d-l2s", "0.05", "--l-seg", "10", "-o", "n.json", "--json"],
+    );
+    let s = json_of(&out);
+    // The trough's cross section is about 320 mm long: 7 courses of 50.8 mm.
+    let n = s["courses"].as_u64().unwrap();
+    assert!((6..=8).contains(&n), "{s}");
+    assert!(s["coverage_percent"].as_f64().unwrap() > 99.0, "{s}");
+    std::fs::write(d.join("bad.json"), r#"{"degree_u": 1}"#).unwrap();
+    let out = towpath(&d, &["layup", "nurbs:bad.json", "--angle", "0", "--tow-width", "6.35", "--tows", "8", "-o", "b.json"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("bad.json"));
+}
