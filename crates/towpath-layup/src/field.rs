@@ -86,9 +86,11 @@ impl Polyline {
         self.cum[self.cum.len() - 1]
     }
     /// Closest point: (point, unit tangent there, arc length, whether the foot lies strictly
-    /// inside the curve rather than at an end).
+    /// inside the curve rather than at an end). The tangent is interpolated along each segment
+    /// between the vertex tangents (mean of the adjacent segment directions), so a field taken
+    /// from a finely sampled curve turns smoothly instead of in steps.
     pub fn closest(&self, p: DVec3) -> (DVec3, DVec3, f64, bool) {
-        let mut best = (f64::INFINITY, DVec3::ZERO, DVec3::X, 0.0, false);
+        let mut best = (f64::INFINITY, DVec3::ZERO, 0usize, 0.0, false);
         let last = self.points.len() - 2;
         for (i, w) in self.points.windows(2).enumerate() {
             let ab = w[1] - w[0];
@@ -98,11 +100,56 @@ impl Polyline {
             let d = q.distance_squared(p);
             if d < best.0 {
                 let inside = !((i == 0 && t <= 0.0) || (i == last && t >= 1.0));
-                best = (d, q, ab / l2.sqrt(), self.cum[i] + t * l2.sqrt(), inside);
+                best = (d, q, i, t, inside);
             }
         }
-        // Smooth the tangent across vertices: blend with the neighbouring segment near a vertex.
-        (best.1, best.2, best.3, best.4)
+        let (_, q, i, t, inside) = best;
+        let n = self.points.len();
+        let seg = |k: usize| (self.points[k + 1] - self.points[k]).normalize();
+        let at_vertex = |k: usize| -> DVec3 {
+            // Vertex k's tangent: mean of the segments meeting there.
+            if k == 0 {
+                seg(0)
+            } else if k == n - 1 {
+                seg(k - 1)
+            } else {
+                (seg(k - 1) + seg(k)).normalize_or_zero()
+            }
+        };
+        // Point and interpolated tangent at arc length σ.
+        let frame = |sigma: f64| -> (DVec3, DVec3) {
+            let k = self.cum.partition_point(|&c| c <= sigma).clamp(1, n - 1) - 1;
+            let len = self.cum[k + 1] - self.cum[k];
+            let u = if len > 0.0 { ((sigma - self.cum[k]) / len).clamp(0.0, 1.0) } else { 0.0 };
+            let tan = at_vertex(k).lerp(at_vertex(k + 1), u).try_normalize().unwrap_or_else(|| seg(k));
+            (self.points[k].lerp(self.points[k + 1], u), tan)
+        };
+        // The foot along the smooth tangent field: (p − γ(σ)) · T(σ) = 0 near the closest
+        // segment, by bisection. At a polyline vertex the plain closest point stays put while p
+        // sweeps the vertex's wedge; this foot moves smoothly, so the field turns smoothly.
+        let lo = self.cum[i.saturating_sub(1)];
+        let hi = self.cum[(i + 2).min(n - 1)];
+        let f = |sigma: f64| {
+            let (g, tan) = frame(sigma);
+            (p - g).dot(tan)
+        };
+        let (mut a, mut b) = (lo, hi);
+        let (fa, fb) = (f(a), f(b));
+        if fa > 0.0 && fb < 0.0 {
+            for _ in 0..40 {
+                let m = 0.5 * (a + b);
+                if f(m) > 0.0 {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            let sigma = 0.5 * (a + b);
+            let (g, tan) = frame(sigma);
+            return (g, tan, sigma, inside);
+        }
+        let (_, tan) = frame(self.cum[i] + t * (self.cum[i + 1] - self.cum[i]));
+        (q, tan, self.cum[i] + t * (self.cum[i + 1] - self.cum[i]), inside)
     }
 }
 

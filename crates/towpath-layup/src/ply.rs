@@ -341,7 +341,7 @@ impl Planner<'_> {
     /// course's edge, the point a quarter tow inside the mesh edge is returned instead (the last
     /// course is shifted onto the surface; the overlap this makes is reported by the quality
     /// figures).
-    fn across(&self, at: &PathPoint, sign: f64, dist: f64) -> Option<(Located, DVec3)> {
+    fn across(&self, at: &PathPoint, sign: f64, dist: f64, allow_shift: bool) -> Option<(Located, DVec3)> {
         let start = crate::course::locate(self.mesh, at.p, at.face)?;
         let b = start.n.cross(at.d) * sign;
         let opts = WalkOptions { max_length: dist, midpoint: true };
@@ -349,7 +349,7 @@ impl Planner<'_> {
         if stop != Stop::Length {
             let reach = w.last().map_or(0.0, |q| q.s);
             let tw = self.spec.tow_width;
-            if stop != Stop::Boundary || reach < 0.5 * dist + 0.5 * tw {
+            if !allow_shift || stop != Stop::Boundary || reach < 0.5 * dist + 0.5 * tw {
                 return None;
             }
             let opts = WalkOptions { max_length: reach - 0.25 * tw, midpoint: true };
@@ -382,7 +382,7 @@ impl Planner<'_> {
                 continue;
             }
             let at = PathPoint { p, n, d, s, face: crate::course::face_hint(prev, s) };
-            let Some((loc, dt)) = self.across(&at, sign, w) else { continue };
+            let Some((loc, dt)) = self.across(&at, sign, w, true) else { continue };
             if !self.useful(loc.p) || self.near_existing(loc.p) < 0.5 * w {
                 continue;
             }
@@ -405,6 +405,12 @@ impl Planner<'_> {
     /// Next course for the parallel method: the geodesic offset of every station of the previous
     /// course, extended at both ends along geodesics to the ply (seed 002 §4).
     fn parallel(&self, prev: &[PathPoint], sign: f64) -> Option<Vec<PathPoint>> {
+        // Whole-width offsets first; only where none fits (the last strip before a mesh edge) is
+        // the course shifted onto the surface.
+        self.parallel_with(prev, sign, false).or_else(|| self.parallel_with(prev, sign, true))
+    }
+
+    fn parallel_with(&self, prev: &[PathPoint], sign: f64, allow_shift: bool) -> Option<Vec<PathPoint>> {
         let w = self.width();
         let len = prev.last()?.s;
         let step = (0.1 * w).clamp(1.0, 10.0);
@@ -414,7 +420,7 @@ impl Planner<'_> {
             let s = (i as f64 * step).min(len);
             let (p, n, d) = crate::course::frame_at(prev, s);
             let at = PathPoint { p, n, d, s, face: crate::course::face_hint(prev, s) };
-            let Some((loc, dt)) = self.across(&at, sign, w) else { continue };
+            let Some((loc, dt)) = self.across(&at, sign, w, allow_shift) else { continue };
             // Drop points where the offset folds back (prev curves tighter than w on this side).
             if let Some(last) = pts.last() {
                 if (loc.p - last.p).dot(last.d) <= 1e-9 {

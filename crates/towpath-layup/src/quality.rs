@@ -77,13 +77,15 @@ pub fn course_figures(c: &Course, field: &dyn DirectionField, spec: &PlySpec) ->
     for (i, p) in pts.iter().enumerate() {
         let dev = field.direction(p.p, p.n).map_or(0.0, |v| v.dot(p.d).abs().clamp(0.0, 1.0).acos().to_degrees());
         q.angle_deviation_deg.push(dev);
-        while j < i && pts[j].s < p.s - h {
+        // The window stays on the same side of any run-out boundary (a run-out is straight).
+        let on = |x: usize| c.on_surface.get(x).copied().unwrap_or(true);
+        while j < i && (pts[j].s < p.s - h || on(j) != on(i)) {
             j += 1;
         }
-        if k < i {
+        if k < i || on(k) != on(i) {
             k = i;
         }
-        while k + 1 < pts.len() && pts[k + 1].s <= p.s + h {
+        while k + 1 < pts.len() && pts[k + 1].s <= p.s + h && on(k + 1) == on(i) {
             k += 1;
         }
         let (a, b) = (&pts[j], &pts[k]);

@@ -221,7 +221,23 @@ fn nurbs_patch_surface_is_tessellated_and_covered() {
     std::fs::write(d.join("patch.json"), patch.to_string()).unwrap();
     let out = towpath(
         &d,
-        &["layup", "nurbs:patch.json", "--angle", "0", "--tow-width", "6.35", "--tows", "8", "--d-l2s", "0.05", "--l-seg", "10", "-o", "n.json", "--json"],
+        &[
+            "layup",
+            "nurbs:patch.json",
+            "--angle",
+            "0",
+            "--tow-width",
+            "6.35",
+            "--tows",
+            "8",
+            "--d-l2s",
+            "0.05",
+            "--l-seg",
+            "10",
+            "-o",
+            "n.json",
+            "--json",
+        ],
     );
     let s = json_of(&out);
     // The trough's cross section is about 320 mm long: 7 courses of 50.8 mm.
@@ -229,7 +245,8 @@ fn nurbs_patch_surface_is_tessellated_and_covered() {
     assert!((6..=8).contains(&n), "{s}");
     assert!(s["coverage_percent"].as_f64().unwrap() > 99.0, "{s}");
     std::fs::write(d.join("bad.json"), r#"{"degree_u": 1}"#).unwrap();
-    let out = towpath(&d, &["layup", "nurbs:bad.json", "--angle", "0", "--tow-width", "6.35", "--tows", "8", "-o", "b.json"]);
+    let out =
+        towpath(&d, &["layup", "nurbs:bad.json", "--angle", "0", "--tow-width", "6.35", "--tows", "8", "-o", "b.json"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("bad.json"));
 }

@@ -1,0 +1,106 @@
+//! Plies on curved surfaces and steered fields where the answer is known in closed form.
+
+use glam::DVec3;
+use towpath_geom::surface::{tessellate_analytic, Analytic, Tessellation};
+use towpath_geom::{BuildOptions, Mesh};
+use towpath_layup::boundary::Region;
+use towpath_layup::field::{Guides, Polyline, Rosette};
+use towpath_layup::ply::{plan, Method, PlySpec};
+
+fn mesh_of(desc: &str, t: Tessellation) -> Mesh {
+    let s = Analytic::parse(desc).unwrap();
+    Mesh::build(&tessellate_analytic(&s, &t).unwrap(), &BuildOptions::default()).unwrap().0
+}
+
+#[test]
+fn geodesic_parallels_on_a_cylinder_panel_leave_no_gaps() {
+    // Half tube: helices at 30° are geodesics and stay one course width apart.
+    let mesh = mesh_of("cylinder:r=300,l=800,a0=0,a1=180", Tessellation::Chord { d_l2s: 0.05, l_seg: 15.0 });
+    let region = Region::whole(&mesh);
+    let field = Rosette { axis: DVec3::Z, angle: 30f64.to_radians() };
+    for method in [Method::Parallel, Method::Field, Method::Natural] {
+        let mut spec = PlySpec::new(6.35, 8);
+        spec.method = method;
+        spec.start = Some(DVec3::new(0.0, 300.0, 400.0));
+        let ply = plan(&mesh, &field, &region, &spec, &mut |_| {}).unwrap();
+        let q = &ply.quality;
+        assert!(ply.courses.len() >= 10, "{method:?}");
+        // Between inner courses: no gap or overlap. The outermost courses are shifted onto the
+        // panel (the panel is not a whole number of courses wide) and overlap their neighbour by
+        // less than half a course.
+        let last = ply.courses.len() - 1;
+        for (i, cq) in q.courses.iter().enumerate() {
+            for &[s, width] in &cq.gap_to_left {
+                if i == 0 || i + 1 == last {
+                    assert!(width > -25.4 && width < 0.1, "{method:?} edge course {i} at {s}: {width}");
+                } else if i < last {
+                    assert!(width.abs() < 0.1, "{method:?} course {i} at {s}: {width}");
+                }
+            }
+        }
+        assert!(q.max_gap < 0.1, "{method:?}: gap {}", q.max_gap);
+        assert!(q.max_angle_deviation_deg < 0.2, "{method:?}: {}", q.max_angle_deviation_deg);
+        assert!(q.points_below_min_radius == 0, "{method:?}");
+        assert!(q.coverage_percent > 99.5, "{method:?}: {}", q.coverage_percent);
+    }
+}
+
+#[test]
+fn concentric_guide_steers_courses_to_the_guide_radius() {
+    // A guide circle of radius 1000 about (−300, 300); on the plate courses follow concentric arcs,
+    // so the steering radius at a point is its distance from the centre.
+    let mesh = mesh_of("plane:a=800,b=600", Tessellation::Chord { d_l2s: 0.1, l_seg: 10.0 });
+    let region = Region::whole(&mesh);
+    let c = DVec3::new(-300.0, 300.0, 0.0);
+    let guide: Vec<DVec3> = (0..=720)
+        .map(|i| {
+            let a = std::f64::consts::PI * (i as f64 / 720.0 - 0.5);
+            c + DVec3::new(a.cos(), a.sin(), 0.0) * 1000.0
+        })
+        .collect();
+    let field = Guides { curves: vec![Polyline::new(guide).unwrap()], angle: 0.0 };
+    let mut spec = PlySpec::new(6.35, 8);
+    spec.start = Some(DVec3::new(400.0, 300.0, 0.0));
+    spec.min_steering_radius = 635.0;
+    let ply = plan(&mesh, &field, &region, &spec, &mut |_| {}).unwrap();
+    let mut checked = 0;
+    for (course, q) in ply.courses.iter().zip(&ply.quality.courses) {
+        // The on-surface part (run-outs beyond the plate edge are straight by construction).
+        let on: Vec<f64> = course.points.iter().zip(&course.on_surface).filter(|(_, &o)| o).map(|(p, _)| p.s).collect();
+        let (s0, s1) = (on[0], on[on.len() - 1]);
+        for (p, r) in course.points.iter().zip(&q.steering_radius) {
+            // Away from the ends (the curvature window is one-sided there).
+            if p.s < s0 + 20.0 || p.s > s1 - 20.0 {
+                continue;
+            }
+            let expect = (p.p - c).length();
+            let r = r.expect("curved");
+            if (r - expect).abs() / expect >= 0.02 {
+                eprintln!(
+                    "course {} s {} of {} (on {s0}..{s1}) pts {}",
+                    course.id,
+                    p.s,
+                    course.length(),
+                    course.points.len()
+                );
+                for x in course.points.iter().filter(|x| (x.s - p.s).abs() < 20.0) {
+                    eprintln!(
+                        "  s {:.2} rad {:.2} ang {:.3}",
+                        x.s,
+                        (x.p - c).length(),
+                        x.d.y.atan2(x.d.x).to_degrees()
+                    );
+                }
+            }
+            assert!((r - expect).abs() / expect < 0.02, "radius {r} vs {expect}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 500);
+    // Courses nearer the centre than 635 mm are flagged.
+    assert!(ply.quality.points_below_min_radius > 0);
+    let min = ply.quality.min_steering_radius.unwrap();
+    let nearest =
+        ply.courses.iter().flat_map(|c| c.points.iter()).map(|p| (p.p - c).length()).fold(f64::INFINITY, f64::min);
+    assert!((min - nearest).abs() / nearest < 0.05, "{min} vs {nearest}");
+}
