@@ -235,7 +235,7 @@ impl DirectionField for Guides {
 /// point by inverse distance over the samples within one band width W, the distance R_k being
 /// measured in the query point's tangent plane (eqs. 3–5: the distance from the sample to the
 /// normal line through the query point). A sample at R_k = 0 is taken as is. Where no sample lies
-/// within W the nearest sample is used (reported as an extrapolation by quality checks).
+/// within W the nearest sample is used ([`Samples::blend`] says whether that happened).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Samples {
     points: Vec<DVec3>,

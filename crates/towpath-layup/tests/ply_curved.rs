@@ -104,3 +104,30 @@ fn concentric_guide_steers_courses_to_the_guide_radius() {
         ply.courses.iter().flat_map(|c| c.points.iter()).map(|p| (p.p - c).length()).fold(f64::INFINITY, f64::min);
     assert!((min - nearest).abs() / nearest < 0.05, "{min} vs {nearest}");
 }
+
+#[test]
+fn a_ply_on_a_real_aircraft_mesh() {
+    // Unwelded binary STL of a swept wing with tail surfaces (feet-scale units; tows scaled to
+    // match: 16 × 0.02).
+    let bytes =
+        include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/../towpath-geom/tests/data/swept_wing_and_tail.stl"));
+    let soup = towpath_geom::io::read_bytes(bytes, towpath_geom::io::Format::Stl).unwrap();
+    let (mesh, _) = Mesh::build(&soup, &BuildOptions::default()).unwrap();
+    let region = Region::whole(&mesh);
+    let field = Rosette { axis: DVec3::X, angle: 0.0 };
+    let spec = PlySpec::new(0.02, 16);
+    let ply = plan(&mesh, &field, &region, &spec, &mut |_| {}).unwrap();
+    assert!(ply.courses.len() > 10);
+    assert_eq!(ply.courses.len(), ply.n1 + ply.n2 + 1);
+    // Field courses follow the design direction exactly, whatever the surface does.
+    assert!(ply.quality.max_angle_deviation_deg < 0.01);
+    assert!(ply.quality.coverage_percent > 90.0, "{}", ply.quality.coverage_percent);
+    for c in &ply.courses {
+        for p in &c.points {
+            assert!(p.p.is_finite() && (p.n.length() - 1.0).abs() < 1e-9 && (p.d.length() - 1.0).abs() < 1e-9);
+        }
+        for ivs in &c.tows {
+            assert!(ivs.windows(2).all(|w| w[0][1] < w[1][0]), "tow intervals ordered and disjoint");
+        }
+    }
+}
