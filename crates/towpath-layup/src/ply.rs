@@ -309,16 +309,32 @@ impl Planner<'_> {
         };
         let Some(d_start) = d_start else { return Vec::new() };
         let mut closed = false;
-        let (fwd, _) = walk(self.mesh, start, d_start, steer, &opts, |q| {
+        let mut last = start.p;
+        let (mut fwd, _) = walk(self.mesh, start, d_start, steer, &opts, |q| {
             if self.outside_far(q.p) {
                 return true;
             }
-            if q.s > 2.0 * w && q.p.distance(start.p) < 0.02 * w {
+            // Back at the start (a hoop): the step from the previous point passes the start.
+            let seg = q.p - last;
+            let t = if seg.length_squared() > 0.0 {
+                ((start.p - last).dot(seg) / seg.length_squared()).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let near = (last + seg * t).distance(start.p);
+            last = q.p;
+            if q.s > 2.0 * w && near < 0.02 * w {
                 closed = true;
                 return true;
             }
             false
         });
+        if closed {
+            // End the loop exactly at the start.
+            if let Some(l) = fwd.last_mut() {
+                *l = PathPoint { p: start.p, n: start.n, ..*l };
+            }
+        }
         let bwd = if closed {
             Vec::new()
         } else {
@@ -436,6 +452,22 @@ impl Planner<'_> {
         let covered = pts.iter().filter(|q| self.near_existing(q.p) < 0.5 * w).count();
         if covered * 2 > pts.len() {
             return None; // wrapped onto existing courses (closed surface)
+        }
+        let closed = prev.len() > 2 && prev[0].p.distance(prev[prev.len() - 1].p) < 0.02 * w;
+        if closed {
+            // The offset of a closed course (a hoop) is closed too: no extension.
+            let mut all = pts;
+            if let Some(&first) = all.first() {
+                all.push(first);
+            }
+            let mut s = 0.0;
+            for i in 0..all.len() {
+                if i > 0 {
+                    s += all[i].p.distance(all[i - 1].p);
+                }
+                all[i].s = s;
+            }
+            return Some(all);
         }
         // Extend both ends geodesically until leaving the ply or the mesh.
         let opts = WalkOptions { max_length: self.max_len, midpoint: true };

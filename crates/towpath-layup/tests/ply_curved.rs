@@ -131,3 +131,24 @@ fn a_ply_on_a_real_aircraft_mesh() {
         }
     }
 }
+
+#[test]
+fn hoop_courses_close_on_themselves() {
+    // 90° to the axis of a tube: every course is a closed hoop of length 2πR.
+    let mesh = mesh_of("cylinder:r=300,l=500", Tessellation::Chord { d_l2s: 0.05, l_seg: 15.0 });
+    let region = Region::whole(&mesh);
+    let field = Rosette { axis: DVec3::Z, angle: 90f64.to_radians() };
+    for method in [Method::Field, Method::Parallel, Method::Natural] {
+        let mut spec = PlySpec::new(6.35, 16);
+        spec.method = method;
+        let ply = plan(&mesh, &field, &region, &spec, &mut |_| {}).unwrap();
+        // 500 / 101.6 = 4.9: five courses.
+        assert_eq!(ply.courses.len(), 5, "{method:?}");
+        for c in &ply.courses {
+            let (a, b) = (c.points[0].p, c.points[c.points.len() - 1].p);
+            assert!(a.distance(b) < 1e-6, "{method:?}: open loop {a} {b}");
+            let circumference = std::f64::consts::TAU * 300.0;
+            assert!((c.length() - circumference).abs() < 0.01 * circumference, "{method:?}: {}", c.length());
+        }
+    }
+}
