@@ -278,11 +278,14 @@ def main():
               "45° fixed-axis course, which is the helix; sphere and cone: the geodesic), compare with the exact "
               "geodesic; time = tessellation + mesh build + trace, as in seed 001. Seed 001 at its finest mesh: mean "
               "0.41 mm (normal 0.008, geodesic 0.41), max 0.81 mm, mean angle 0.10°.", "",
-              "| surface | D_l2s | L_seg | triangles | mean dev. | mean normal | mean geodesic | max dev. | max normal | max geodesic | mean angle (°) | MSE angle (°²) | max angle (°) | time (s) |",
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+              "Each configuration is traced twice: with towpath's smooth normals and midpoint rule, and with seed "
+              "001's scheme (face normals inside triangles, the area-weighted normal of the two faces on an edge, "
+              "direction taken at the entry point) for comparison.", "",
+              "| surface | normals | D_l2s | L_seg | triangles | mean dev. | mean normal | mean geodesic | max dev. | max normal | max geodesic | mean angle (°) | MSE angle (°²) | max angle (°) | time (s) |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in acc:
         d = r["deviation"]
-        lines.append(f"| {r['surface']} | {r['d_l2s']} | {r['l_seg']:.0f} | {r['triangles']} | {d['mean']:.4f} | {d['mean_normal']:.4f} | "
+        lines.append(f"| {r['surface']} | {r['mode']} | {r['d_l2s']} | {r['l_seg']:.0f} | {r['triangles']} | {d['mean']:.4f} | {d['mean_normal']:.4f} | "
                      f"{d['mean_geodesic']:.4f} | {d['max']:.4f} | {d['max_normal']:.4f} | {d['max_geodesic']:.4f} | "
                      f"{d['mean_angle_deg']:.4f} | {d['mse_angle_deg2']:.5f} | {d['max_angle_deg']:.4f} | {r['seconds']:.3f} |")
     lines.append("")

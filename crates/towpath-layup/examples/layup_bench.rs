@@ -58,21 +58,23 @@ fn main() {
     let mut rows = Vec::new();
     for (name, desc, p0, d0, field_course) in cases {
         let s = Analytic::parse(desc).expect("surface");
-        for d_l2s in [0.05, 0.2, 0.5, 1.0] {
-            for l_seg in [10.0, 20.0, 65.0, 110.0] {
-                let t0 = Instant::now();
-                let soup = tessellate_analytic(&s, &Tessellation::Chord { d_l2s, l_seg }).expect("tessellation");
-                let (mesh, _) = Mesh::build(&soup, &BuildOptions::default()).expect("mesh");
-                let start = Located::new(&mesh, mesh.closest_point(p0).expect("start"));
-                let rosette = Rosette { axis: DVec3::Z, angle: 45f64.to_radians() };
-                let steer = if field_course { Steering::Field(&rosette) } else { Steering::Geodesic };
-                let opts = WalkOptions { max_length: 500.0, midpoint: true };
-                let path = trace_both(&mesh, start, d0, steer, &opts, |_| false).expect("trace");
-                let secs = t0.elapsed().as_secs_f64();
-                let reference = Reference::new(s, start.p, path.points[path.start_index].d).expect("reference");
-                let dev = deviation(&reference, &path.points, path.points[path.start_index].s);
-                rows.push(json!({"surface": name, "d_l2s": d_l2s, "l_seg": l_seg, "triangles": mesh.num_faces(),
+        for (mode, smooth) in [("smooth normals, midpoint", true), ("face normals, entry point (seed 001)", false)] {
+            for d_l2s in [0.05, 0.2, 0.5, 1.0] {
+                for l_seg in [10.0, 20.0, 65.0, 110.0] {
+                    let t0 = Instant::now();
+                    let soup = tessellate_analytic(&s, &Tessellation::Chord { d_l2s, l_seg }).expect("tessellation");
+                    let (mesh, _) = Mesh::build(&soup, &BuildOptions::default()).expect("mesh");
+                    let start = Located::new(&mesh, mesh.closest_point(p0).expect("start"));
+                    let rosette = Rosette { axis: DVec3::Z, angle: 45f64.to_radians() };
+                    let steer = if field_course { Steering::Field(&rosette) } else { Steering::Geodesic };
+                    let opts = WalkOptions { max_length: 500.0, midpoint: smooth, smooth_normals: smooth };
+                    let path = trace_both(&mesh, start, d0, steer, &opts, |_| false).expect("trace");
+                    let secs = t0.elapsed().as_secs_f64();
+                    let reference = Reference::new(s, start.p, path.points[path.start_index].d).expect("reference");
+                    let dev = deviation(&reference, &path.points, path.points[path.start_index].s);
+                    rows.push(json!({"surface": name, "mode": mode, "d_l2s": d_l2s, "l_seg": l_seg, "triangles": mesh.num_faces(),
                     "length": path.length(), "seconds": secs, "deviation": dev}));
+                }
             }
         }
     }
@@ -117,7 +119,7 @@ fn main() {
             .collect();
         std::fs::write(out.join(format!("starts_{name}.json")), serde_json::to_string(&starts_json).expect("json"))
             .expect("write");
-        let opts = WalkOptions { max_length: 1000.0, midpoint: true };
+        let opts = WalkOptions::up_to(1000.0);
         let mut polylines = Vec::new();
         let mut times = Vec::new();
         for (_, loc, d) in &starts {

@@ -302,7 +302,7 @@ impl Planner<'_> {
     /// closed once instead of wrapping again.
     fn trace(&self, start: Located, d0: DVec3, steer: Steering<'_>) -> Vec<PathPoint> {
         let w = self.width();
-        let opts = WalkOptions { max_length: self.max_len, midpoint: true };
+        let opts = WalkOptions::up_to(self.max_len);
         let d_start = match steer {
             Steering::Field(f) => f.direction(start.p, start.n).map(|v| if v.dot(d0) < 0.0 { -v } else { v }),
             Steering::Geodesic => tangent(d0, start.n),
@@ -360,7 +360,7 @@ impl Planner<'_> {
     fn across(&self, at: &PathPoint, sign: f64, dist: f64, allow_shift: bool) -> Option<(Located, DVec3)> {
         let start = crate::course::locate(self.mesh, at.p, at.face)?;
         let b = start.n.cross(at.d) * sign;
-        let opts = WalkOptions { max_length: dist, midpoint: true };
+        let opts = WalkOptions::up_to(dist);
         let (mut w, stop) = walk(self.mesh, start, b, Steering::Geodesic, &opts, |_| false);
         if stop != Stop::Length {
             let reach = w.last().map_or(0.0, |q| q.s);
@@ -368,7 +368,7 @@ impl Planner<'_> {
             if !allow_shift || stop != Stop::Boundary || reach < 0.5 * dist + 0.5 * tw {
                 return None;
             }
-            let opts = WalkOptions { max_length: reach - 0.25 * tw, midpoint: true };
+            let opts = WalkOptions::up_to(reach - 0.25 * tw);
             let (w2, stop2) = walk(self.mesh, start, b, Steering::Geodesic, &opts, |_| false);
             if stop2 != Stop::Length {
                 return None;
@@ -470,7 +470,7 @@ impl Planner<'_> {
             return Some(all);
         }
         // Extend both ends geodesically until leaving the ply or the mesh.
-        let opts = WalkOptions { max_length: self.max_len, midpoint: true };
+        let opts = WalkOptions::up_to(self.max_len);
         let ext = |q: &PathPoint, dir: DVec3| -> Vec<PathPoint> {
             let Some(loc) = crate::course::locate(self.mesh, q.p, q.face) else { return Vec::new() };
             walk(self.mesh, loc, dir, Steering::Geodesic, &opts, |x| self.outside_far(x.p)).0
@@ -558,10 +558,7 @@ impl Planner<'_> {
             };
             for (k, sign) in [(0usize, 1.0f64), (1, -1.0)] {
                 let b = n.cross(d) * sign;
-                let opts = WalkOptions {
-                    max_length: self.max_len.min(2.0 * std::f64::consts::PI * self.max_len),
-                    midpoint: true,
-                };
+                let opts = WalkOptions::up_to(self.max_len);
                 let (wk, _) = walk(self.mesh, start, b, Steering::Geodesic, &opts, |q| {
                     (self.region.has_curve() && self.region.curve_distance(q.p) < 0.0)
                         || (q.s > w && q.p.distance(start.p) < 0.02 * w)

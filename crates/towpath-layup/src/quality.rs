@@ -140,7 +140,7 @@ fn spacing_to(mesh: &Mesh, c: &Course, near: &Nearest, s: f64, reach: f64) -> Op
     let (p, _, d) = c.frame_at(s);
     let start = crate::course::locate(mesh, p, crate::course::face_hint(&c.points, s))?;
     let b = start.n.cross(d);
-    let opts = WalkOptions { max_length: reach, midpoint: true };
+    let opts = WalkOptions::up_to(reach);
     // Side of x relative to the neighbour: > 0 left of it.
     let side = |x: DVec3| -> Option<(f64, f64)> {
         let (f, n, sf, dir) = near.foot_frame(x)?;

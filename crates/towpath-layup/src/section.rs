@@ -169,7 +169,7 @@ impl Sectioner<'_> {
                     if reach <= 0.0 {
                         return (Vec::new(), Stop::Length);
                     }
-                    let opts = WalkOptions { max_length: reach + 1e-9, midpoint: true };
+                    let opts = WalkOptions::up_to(reach + 1e-9);
                     walk(self.mesh, start, dir, Steering::Geodesic, &opts, |_| false)
                 };
                 let (left, stop_l) = side(b, reach_l);

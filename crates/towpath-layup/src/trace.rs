@@ -134,12 +134,32 @@ pub struct WalkOptions {
     /// Evaluate the direction at the middle of each step (recommended; off reproduces seed 001's
     /// entry-point rule for comparison).
     pub midpoint: bool,
+    /// Smooth (interpolated vertex) normals (recommended). Off reproduces seed 001: the face
+    /// normal inside a triangle and the area-weighted normal of the two faces on an edge (eq. 12).
+    pub smooth_normals: bool,
 }
 
 impl Default for WalkOptions {
     fn default() -> Self {
-        WalkOptions { max_length: f64::INFINITY, midpoint: true }
+        WalkOptions { max_length: f64::INFINITY, midpoint: true, smooth_normals: true }
     }
+}
+
+impl WalkOptions {
+    /// Default options with a length limit.
+    pub fn up_to(max_length: f64) -> WalkOptions {
+        WalkOptions { max_length, ..WalkOptions::default() }
+    }
+}
+
+/// Seed 001's normal on an edge: the area-weighted mean of the normals of the faces on it.
+fn edge_normal(mesh: &Mesh, f: u32, edge: usize) -> DVec3 {
+    let g = mesh.neighbor(f, edge);
+    let mut n = mesh.face_normal(f) * mesh.face_area(f);
+    if g != NO_FACE {
+        n += mesh.face_normal(g) * mesh.face_area(g);
+    }
+    n.try_normalize().unwrap_or(mesh.face_normal(f))
 }
 
 /// Walks from `start` in the tangent direction `d0` (projected into the tangent plane) until a
@@ -154,11 +174,12 @@ pub fn walk(
     mut stop: impl FnMut(&PathPoint) -> bool,
 ) -> (Vec<PathPoint>, Stop) {
     let mut out = Vec::new();
-    let Some(mut d) = tangent(d0, start.n) else { return (out, Stop::Stuck) };
+    let n_start = if opts.smooth_normals { start.n } else { mesh.face_normal(start.sp.face) };
+    let Some(mut d) = tangent(d0, n_start) else { return (out, Stop::Stuck) };
     let mut f = start.sp.face;
     let mut b = start.sp.bary;
     let mut p = start.p;
-    let mut n = start.n;
+    let mut n = if opts.smooth_normals { start.n } else { mesh.face_normal(start.sp.face) };
     let mut s = 0.0;
     let mut entry: Option<usize> = None;
     let mut zero_steps = 0u32;
@@ -191,7 +212,7 @@ pub fn walk(
             // Corrector: the direction at the middle of the predicted step.
             let bm = b + db * (0.5 * t);
             let sm = SurfacePoint { face: f, bary: bm };
-            let nm = mesh.smooth_normal(sm);
+            let nm = if opts.smooth_normals { mesh.smooth_normal(sm) } else { nf };
             let pm = p + dface * (0.5 * t);
             if let Some(dm) = dir_at(pm, nm, d, n) {
                 if let Some(df2) = tangent(dm, nf) {
@@ -219,7 +240,13 @@ pub fn walk(
         let nb = nb / (nb.x + nb.y + nb.z);
         let sp = SurfacePoint { face: f, bary: nb };
         let np = mesh.point(sp);
-        let nn = mesh.smooth_normal(sp);
+        let nn = if opts.smooth_normals {
+            mesh.smooth_normal(sp)
+        } else if clipped {
+            nf
+        } else {
+            edge_normal(mesh, f, edge)
+        };
         s += np.distance(p);
         let nd = dir_at(np, nn, d_step, n_step).or_else(|| tangent(transport(d_step, n_step, nn), nn));
         let Some(nd) = nd else { return (out, Stop::Stuck) };
