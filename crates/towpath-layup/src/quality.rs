@@ -286,7 +286,7 @@ pub fn assess(
     // Samples: every face split into m × m sub-triangles (m from the face size and a spacing of
     // half a tow width, within a budget), one sample at each sub-triangle's centroid.
     let nf = mesh.num_faces();
-    let budget = 120_000.0;
+    let budget = 50_000.0;
     let mut h = 0.5 * spec.tow_width;
     let edge_max = |f: u32| {
         let c = mesh.corners(f);
