@@ -21,6 +21,9 @@ enum Command {
     Demo(cmd::demo::Args),
     /// Solve a TSPLIB (TSP, ATSP, SOP), GTSP-LIB, PCGLNS or towpath JSON problem file.
     Solve(cmd::solve::Args),
+    /// Generate the fiber courses of a ply on a mold surface (mesh or analytic), trimmed per tow,
+    /// with quality figures; write JSON, CSV and G-code.
+    Layup(Box<cmd::layup::Args>),
 }
 
 fn main() {
@@ -28,6 +31,7 @@ fn main() {
     let result = match cli.command {
         Command::Demo(args) => cmd::demo::run(args),
         Command::Solve(args) => cmd::solve::run(args),
+        Command::Layup(args) => cmd::layup::run(*args),
     };
     std::process::exit(exit::report(result));
 }
