@@ -17,14 +17,20 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run the built-in demo: a generated part, sequenced and checked, with no files of your own.
+    /// Run the built-in demo: seed 000's AFP parts written, optimized, verified and reported.
     Demo(cmd::demo::Args),
+    /// Re-sequence an AFP program: same part, laid identically, less off-part motion, verified.
+    Optimize(cmd::optimize::Args),
+    /// Check an optimized AFP program against its original and print the savings.
+    Verify(cmd::verify::Args),
 }
 
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Demo(args) => cmd::demo::run(args),
+        Command::Optimize(args) => cmd::optimize::run(args),
+        Command::Verify(args) => cmd::verify::run(args),
     };
     std::process::exit(exit::report(result));
 }

@@ -1,3 +1,6 @@
 //! One module per subcommand.
 
+mod afp_common;
 pub mod demo;
+pub mod optimize;
+pub mod verify;

@@ -1,0 +1,216 @@
+//! The rewriter: a program in a new course order, with only the off-part transit regenerated.
+//!
+//! Header, footer, every course span (approach, on-part and retract blocks) and every other line
+//! are copied byte for byte; a reversed course's span is the one [`crate::reverse_course`] builds.
+//! Between two spans the rewriter writes one rapid move that takes the machine from the end of
+//! the first to exactly the state (programmed values, set-position offsets, distance mode,
+//! motion mode, feed) in which the original program entered the second, so the second runs
+//! exactly as it did. Continuous and mandrel axes move the short way round; when that leaves a
+//! programmed value that differs from the original by whole turns, a set-position line
+//! re-declares the original value. In the original order the output is the input, unchanged.
+
+use towpath_machine::Machine;
+
+use crate::dialect::Dialect;
+use crate::error::NcError;
+use crate::interp::{wrap, Interp, Modal};
+use crate::program::{join_lines, Item, Program};
+use crate::reverse::{fmt_num, shift_decimal, Reversed};
+
+/// One course in the new order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Placement {
+    /// The course (index into [`Program::courses`]).
+    pub course: usize,
+    /// Laid in reverse.
+    pub reversed: bool,
+}
+
+/// Writes the program with its courses in `order`. `reversed[c]` must hold the reversed span of
+/// every course placed reversed.
+pub fn rewrite(
+    program: &Program,
+    order: &[Placement],
+    machine: &Machine,
+    dialect: &Dialect,
+    reversed: &[Option<Reversed>],
+) -> Result<String, NcError> {
+    let k = program.courses.len();
+    if order.len() != k {
+        return Err(NcError::Request(format!("the order has {} courses, the program {k}", order.len())));
+    }
+    let mut seen = vec![false; k];
+    for p in order {
+        if p.course >= k || std::mem::replace(&mut seen[p.course], true) {
+            return Err(NcError::Request(format!("course {} is missing or repeated in the order", p.course)));
+        }
+    }
+    if order.iter().enumerate().all(|(i, p)| p.course == i && !p.reversed) {
+        return Ok(program.text());
+    }
+    let crlf = program.lines.iter().filter(|l| l.ends_with('\r')).count() * 2 > program.lines.len();
+    let mut e = Emitter { out: Vec::with_capacity(program.lines.len() + 2 * k), it: Interp::new(dialect, machine)?, dialect, machine, crlf };
+    for j in 0..program.header_end {
+        e.original(program, j)?;
+    }
+    let mut prev: Option<usize> = None;
+    for p in order {
+        let course = &program.courses[p.course];
+        if let Some(pc) = prev {
+            e.items(program, &program.courses[pc].post)?;
+        }
+        e.items(program, &course.pre_before)?;
+        let rev = if p.reversed {
+            match reversed.get(p.course).and_then(Option::as_ref) {
+                Some(r) => Some(r),
+                None => return Err(NcError::Request(format!("{} cannot be reversed", program.course_name(p.course)))),
+            }
+        } else {
+            None
+        };
+        let target = rev.map_or(&course.insert, |r| &r.entry);
+        e.transit(target)?;
+        e.items(program, &course.pre_after)?;
+        match rev {
+            Some(r) => {
+                for l in &r.lines {
+                    e.generated(l.clone())?;
+                }
+            }
+            None => {
+                for j in course.span.clone() {
+                    e.original(program, j)?;
+                }
+            }
+        }
+        prev = Some(p.course);
+    }
+    if let Some(pc) = prev {
+        e.items(program, &program.courses[pc].post)?;
+    }
+    for j in program.footer_start..program.lines.len() {
+        e.original(program, j)?;
+    }
+    Ok(join_lines(e.out.iter().map(String::as_str), program.final_newline))
+}
+
+struct Emitter<'a> {
+    out: Vec<String>,
+    it: Interp<'a>,
+    dialect: &'a Dialect,
+    machine: &'a Machine,
+    crlf: bool,
+}
+
+impl Emitter<'_> {
+    fn original(&mut self, program: &Program, j: usize) -> Result<(), NcError> {
+        let line = &program.lines[j];
+        self.it.apply(j, line).map_err(|err| NcError::SelfCheck(format!("replaying original {err}")))?;
+        self.out.push(line.clone());
+        Ok(())
+    }
+
+    fn generated(&mut self, mut line: String) -> Result<(), NcError> {
+        let n = self.out.len();
+        self.it
+            .apply(n, &line)
+            .map_err(|err| NcError::SelfCheck(format!("a line towpath wrote ({line:?}) does not run: {err}")))?;
+        if self.crlf {
+            line.push('\r');
+        }
+        self.out.push(line);
+        Ok(())
+    }
+
+    fn items(&mut self, program: &Program, items: &[Item]) -> Result<(), NcError> {
+        for item in items {
+            match item {
+                Item::Line(j) => self.original(program, *j)?,
+                Item::Kept(_, text) => self.generated(text.clone())?,
+            }
+        }
+        Ok(())
+    }
+
+    /// One rapid move (and set-position and mode lines if needed) to reach `target`.
+    fn transit(&mut self, target: &Modal) -> Result<(), NcError> {
+        let d = self.dialect;
+        let m = self.machine;
+        let cur = self.it.m.clone();
+        let dim = m.dim();
+        let text_of = |t: &Modal, i: usize| t.text[i].clone().unwrap_or_else(|| fmt_num(t.prog[i], d.decimals));
+        let label = |i: usize| m.axes[i].label.to_ascii_uppercase();
+        let mut axis_words = Vec::new();
+        let mut reset = Vec::new();
+        for i in 0..dim {
+            let wraps = m.axes[i].kind.wraps();
+            let delta = if wraps { wrap(target.phys[i] - cur.phys[i]) } else { target.phys[i] - cur.phys[i] };
+            let same_prog = (cur.prog[i] - target.prog[i]).abs() <= 1e-9;
+            if delta.abs() <= 1e-9 {
+                if !same_prog {
+                    reset.push(format!("{}{}", label(i), text_of(target, i)));
+                }
+                continue;
+            }
+            // The value that moves the axis by `delta`.
+            let (written, needs_reset) = if d.rollover && wraps {
+                if (wrap(target.prog[i] - cur.prog[i]) - delta).abs() <= 1e-9 {
+                    (text_of(target, i), false)
+                } else {
+                    (fmt_num(cur.prog[i] + delta, d.decimals), true)
+                }
+            } else {
+                let v = cur.prog[i] + delta;
+                if (v - target.prog[i]).abs() <= 1e-9 {
+                    (text_of(target, i), false)
+                } else {
+                    let turns = ((v - target.prog[i]) / 360.0).round();
+                    let exact = if wraps && (v - target.prog[i] - 360.0 * turns).abs() <= 1e-6 {
+                        shift_decimal(&text_of(target, i), 360.0 * turns)
+                    } else {
+                        None
+                    };
+                    (exact.unwrap_or_else(|| fmt_num(v, d.decimals)), true)
+                }
+            };
+            axis_words.push(format!("{}{}", label(i), written));
+            if needs_reset {
+                reset.push(format!("{}{}", label(i), text_of(target, i)));
+            }
+        }
+        if !axis_words.is_empty() {
+            let mut words = Vec::new();
+            if cur.incremental {
+                words.push(d.absolute.clone());
+            }
+            words.push(d.rapid.first().cloned().unwrap_or_else(|| "G0".into()));
+            words.extend(axis_words);
+            self.generated(words.join(" "))?;
+        }
+        if !reset.is_empty() {
+            let mut words = vec![d.set_position.clone()];
+            words.extend(reset);
+            self.generated(words.join(" "))?;
+        }
+        let now = self.it.m.clone();
+        let mut modal = Vec::new();
+        if now.incremental != target.incremental {
+            modal.push(if target.incremental { d.incremental.clone() } else { d.absolute.clone() });
+        }
+        if let Some(r) = target.rapid {
+            if now.rapid != Some(r) {
+                let code = if r { d.rapid.first() } else { d.feed.first() };
+                modal.push(code.cloned().unwrap_or_default());
+            }
+        }
+        if let Some((v, t)) = &target.feed {
+            if now.feed.as_ref().map(|f| f.0) != Some(*v) {
+                modal.push(format!("{}{}", d.feed_word.to_ascii_uppercase(), t));
+            }
+        }
+        if !modal.is_empty() {
+            self.generated(modal.join(" "))?;
+        }
+        Ok(())
+    }
+}
