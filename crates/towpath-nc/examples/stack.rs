@@ -17,6 +17,18 @@ fn main() {
     };
     let o = optimize(&text, &m, &d, &opts).unwrap();
     let (b, a) = o.verification.motion(towpath_machine::CostKind::Axis).unwrap();
-    eprintln!("courses {} edges {} sets {} timings {:?}", o.program.courses.len(), o.afp.edges, o.afp.sets.len(), o.timings);
-    eprintln!("off {:.0} -> {:.0} ({:.1}%) solver {:?}", b.off_part(), a.off_part(), 100.0*(1.0-a.off_part()/b.off_part()), o.solver);
+    eprintln!(
+        "courses {} edges {} sets {} timings {:?}",
+        o.program.courses.len(),
+        o.afp.edges,
+        o.afp.sets.len(),
+        o.timings
+    );
+    eprintln!(
+        "off {:.0} -> {:.0} ({:.1}%) solver {:?}",
+        b.off_part(),
+        a.off_part(),
+        100.0 * (1.0 - a.off_part() / b.off_part()),
+        o.solver
+    );
 }

@@ -135,7 +135,10 @@ fn ply_courses(p: &PlySpec) -> Vec<CourseGeom> {
     // Extent of the rectangle across the courses.
     let corners = [[r[0], r[1]], [r[2], r[1]], [r[2], r[3]], [r[0], r[3]]];
     let across: Vec<f64> = corners.iter().map(|c| (c[0] - centre[0]) * n[0] + (c[1] - centre[1]) * n[1]).collect();
-    let (lo, hi) = (across.iter().cloned().fold(f64::INFINITY, f64::min), across.iter().cloned().fold(f64::NEG_INFINITY, f64::max));
+    let (lo, hi) = (
+        across.iter().cloned().fold(f64::INFINITY, f64::min),
+        across.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+    );
     let count = ((hi - lo) / w).ceil() as usize;
     let start = (lo + hi) / 2.0 - (count as f64 - 1.0) * w / 2.0;
     let mut out = Vec::new();
@@ -345,7 +348,11 @@ pub fn stacked_panel(plies: usize, courses: usize) -> String {
         let jx = ((p * 7919) % 401) as f64 - 200.0;
         let jy = ((p * 104_729) % 401) as f64 - 200.0;
         let (cx, cy) = (3000.0 + jx, 3000.0 + jy);
-        specs.push(ply(&format!("stack {a} deg"), [cx - side / 2.0, cy - side / 2.0, cx + side / 2.0, cy + side / 2.0], a));
+        specs.push(ply(
+            &format!("stack {a} deg"),
+            [cx - side / 2.0, cy - side / 2.0, cx + side / 2.0, cy + side / 2.0],
+            a,
+        ));
     }
     program("stacked panel", Surface::Plane, &specs)
 }

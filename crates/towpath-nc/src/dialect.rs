@@ -215,7 +215,9 @@ impl Dialect {
             return Err(NcError::Dialect(format!("decimals: {} is more than 9", self.decimals)));
         }
         if !self.comment_parens && !self.comment_semicolon {
-            return Err(NcError::Dialect("comments: enable comment_parens or comment_semicolon (markers are comments)".into()));
+            return Err(NcError::Dialect(
+                "comments: enable comment_parens or comment_semicolon (markers are comments)".into(),
+            ));
         }
         if self.ply_comment.trim().is_empty() {
             return Err(NcError::Dialect("ply_comment: must not be empty".into()));

@@ -305,7 +305,10 @@ impl<'a> Interp<'a> {
         }
         if restart || cut {
             let Some(mw) = mask else {
-                return Err(NcError::line(n, format!("tow {} without a {} mask word", if restart { "restart" } else { "cut" }, c.mask_word)));
+                return Err(NcError::line(
+                    n,
+                    format!("tow {} without a {} mask word", if restart { "restart" } else { "cut" }, c.mask_word),
+                ));
             };
             let v = mw.value;
             if !(v >= 1.0 && v.fract() == 0.0 && v < 9.0e15) {
@@ -352,8 +355,11 @@ impl<'a> Interp<'a> {
                 out.before = events.clone();
             }
             for (i, w) in &axes {
-                let (target, text) =
-                    if self.m.incremental { (self.m.prog[*i] + w.value, None) } else { (w.value, Some(w.text.clone())) };
+                let (target, text) = if self.m.incremental {
+                    (self.m.prog[*i] + w.value, None)
+                } else {
+                    (w.value, Some(w.text.clone()))
+                };
                 // Physical value: the programmed one plus the set-position offset (kept exact
                 // when there is none), or, for a roll-over controller, the short way round.
                 let offset = self.m.phys[*i] - self.m.prog[*i];

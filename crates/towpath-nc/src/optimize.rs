@@ -4,7 +4,7 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 use towpath_machine::Machine;
-use towpath_seq::{solve, SolveOptions};
+use towpath_seq::{check, solve, SolveOptions, Step};
 
 use crate::dialect::Dialect;
 use crate::error::NcError;
@@ -94,7 +94,12 @@ pub struct Optimized {
 
 /// Optimizes a program: returns the rewritten text, verified against the input, never costing
 /// more off-part motion (under the chosen cost model) than the input.
-pub fn optimize(text: &str, machine: &Machine, dialect: &Dialect, opts: &OptimizeOptions) -> Result<Optimized, NcError> {
+pub fn optimize(
+    text: &str,
+    machine: &Machine,
+    dialect: &Dialect,
+    opts: &OptimizeOptions,
+) -> Result<Optimized, NcError> {
     let t0 = Instant::now();
     let program = crate::parse::parse(text, machine, dialect)?;
     let t_parse = t0.elapsed().as_secs_f64();
@@ -163,4 +168,29 @@ pub fn optimize(text: &str, machine: &Machine, dialect: &Dialect, opts: &Optimiz
         },
         fell_back,
     })
+}
+
+/// Writes the program for a route found by any solver over `afp.problem` and verifies it
+/// against the original: the way to run another sequencing algorithm (seed 000's, for one) on
+/// the same parts. The steps are checked against the problem first.
+pub fn apply_steps(
+    program: &Program,
+    afp: &AfpProblem,
+    steps: &[Step],
+    machine: &Machine,
+    dialect: &Dialect,
+    opts: &crate::problem::AfpOptions,
+) -> Result<(String, Verification), NcError> {
+    check(&afp.problem, steps).map_err(|v| NcError::Sequencing(format!("the route is not feasible: {v}")))?;
+    let order = placements(steps);
+    let text = rewrite(program, &order, machine, dialect, &afp.reversed)?;
+    let parsed = crate::parse::parse(&text, machine, dialect).map_err(|e| NcError::SelfCheck(e.to_string()))?;
+    let vopts = VerifyOptions {
+        width: opts.width_or(dialect),
+        strict_plies: opts.precedence == crate::problem::PrecedenceRule::Plies,
+        keep_ply_order: opts.keep_ply_order,
+    };
+    let v = verify_parsed(program, &parsed, machine, dialect, &vopts, afp.footprints.as_ref())
+        .map_err(|e| NcError::SelfCheck(e.to_string()))?;
+    Ok((text, v))
 }

@@ -99,7 +99,8 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
         return Err(NcError::line(s + 1, format!("the course opened here is never closed ({close})")));
     }
     if spans.is_empty() {
-        let what = if has_contact { format!("no {} roller contact", dialect.contact_on) } else { "no tow restart".into() };
+        let what =
+            if has_contact { format!("no {} roller contact", dialect.contact_on) } else { "no tow restart".into() };
         return Err(NcError::Request(format!("the program has no courses ({what} found)")));
     }
 
@@ -128,7 +129,11 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
         span_end[k - 1] = if r > 0 { ms[r - 1] + 1 } else { lo };
     }
     let footer_start = span_end[k - 1];
-    let header_end = (0..span_start[0]).find(|&j| facts[j].motion || facts[j].marker.is_some()).unwrap_or(span_start[0]);
+    // The header runs to the first marker, or without one to the first move.
+    let header_end = (0..span_start[0])
+        .find(|&j| facts[j].marker.is_some())
+        .or_else(|| (0..span_start[0]).find(|&j| facts[j].motion))
+        .unwrap_or(span_start[0]);
     middle_start[0] = header_end;
 
     // Plies and course numbers, in line order.
@@ -141,12 +146,7 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
         for (j, f) in facts.iter().enumerate() {
             if c < k && j == spans[c].0 {
                 if plies.is_empty() {
-                    plies.push(Ply {
-                        label: "(no ply marker)".into(),
-                        number: None,
-                        line: None,
-                        courses: Vec::new(),
-                    });
+                    plies.push(Ply { label: "(no ply marker)".into(), number: None, line: None, courses: Vec::new() });
                 }
                 course_ply[c] = plies.len() - 1;
                 course_number[c] = pending_number.take();

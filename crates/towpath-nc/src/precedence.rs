@@ -226,7 +226,8 @@ pub fn course_precedence(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<(usize, 
                             }
                         }
                     }
-                    let mut list: Vec<u32> = sc.list.iter().copied().filter(|&b| sc.state[b as usize] == OVERLAP).collect();
+                    let mut list: Vec<u32> =
+                        sc.list.iter().copied().filter(|&b| sc.state[b as usize] == OVERLAP).collect();
                     list.sort_unstable_by_key(|&b| (std::cmp::Reverse(ply_of[b as usize]), b));
                     let mut mine = if use_bits { Bits::new(n) } else { Bits::default() };
                     let mut preds = Vec::new();

@@ -212,7 +212,12 @@ impl Report {
             precedence_sets: o.afp.sets.len(),
             precedence_edges: o.afp.edges,
             reversed: v.reversed,
-            not_reversible: o.afp.not_reversible.iter().map(|(c, why)| format!("{}: {why}", p.course_name(*c))).collect(),
+            not_reversible: o
+                .afp
+                .not_reversible
+                .iter()
+                .map(|(c, why)| format!("{}: {why}", p.course_name(*c)))
+                .collect(),
             totals: totals(v),
             per_ply,
             per_set,
@@ -254,7 +259,11 @@ impl Report {
             self.cost,
             if self.bidirectional { "bidirectional" } else { "unidirectional" }
         );
-        let _ = writeln!(s, "  {:<6} {:>14} {:>14} {:>8} {:>14} {:>14} {:>8}", "cost", "off-part in", "off-part out", "saved", "total in", "total out", "saved");
+        let _ = writeln!(
+            s,
+            "  {:<6} {:>14} {:>14} {:>8} {:>14} {:>14} {:>8}",
+            "cost", "off-part in", "off-part out", "saved", "total in", "total out", "saved"
+        );
         for t in &self.totals {
             let _ = writeln!(
                 s,
@@ -329,7 +338,8 @@ impl Report {
             for r in rows {
                 let _ = write!(h, "<tr><td>{}</td><td>{}</td>", esc(&r.label), r.courses);
                 for g in &r.off_part {
-                    let _ = write!(h, "<td>{:.1}</td><td>{:.1}</td><td>{:.1} %</td>", g.before, g.after, g.saved_percent);
+                    let _ =
+                        write!(h, "<td>{:.1}</td><td>{:.1}</td><td>{:.1} %</td>", g.before, g.after, g.saved_percent);
                 }
                 h.push_str("</tr>\n");
             }
@@ -378,7 +388,9 @@ fn polylines(p: &Program, machine: &Machine, frame: &Frame) -> Vec<(bool, Vec<[f
             continue;
         }
         match out.last_mut() {
-            Some((on, pts)) if *on == s.on_part && pts.last().is_some_and(|l| (l[0] - a[0]).abs() + (l[1] - a[1]).abs() < 1e-9) => {
+            Some((on, pts))
+                if *on == s.on_part && pts.last().is_some_and(|l| (l[0] - a[0]).abs() + (l[1] - a[1]).abs() < 1e-9) =>
+            {
                 pts.push(b)
             }
             _ => out.push((s.on_part, vec![a, b])),
@@ -434,7 +446,9 @@ fn plan_views(o: &Optimized, optimized: &Program, machine: &Machine) -> Option<S
         s
     };
     let off = |m: &[Motion]| {
-        m.iter().find(|x| x.kind == CostKind::Tool).map_or(String::new(), |x| format!("off-part tool path {:.0} mm", x.off_part()))
+        m.iter()
+            .find(|x| x.kind == CostKind::Tool)
+            .map_or(String::new(), |x| format!("off-part tool path {:.0} mm", x.off_part()))
     };
     let label = if matches!(frame, Frame::Cylinder { .. }) { " (cylinder unrolled)" } else { "" };
     Some(format!(

@@ -122,7 +122,8 @@ pub fn reverse_course(program: &Program, c: usize, machine: &Machine, dialect: &
         let hi = prog.iter().map(|p| p[h]).fold(f64::NEG_INFINITY, f64::max);
         shift = match ax.kind {
             AxisKind::Rotary => {
-                let fits = |s: f64| ax.max.is_none_or(|m| hi + s <= m + 1e-9) && ax.min.is_none_or(|m| lo + s >= m - 1e-9);
+                let fits =
+                    |s: f64| ax.max.is_none_or(|m| hi + s <= m + 1e-9) && ax.min.is_none_or(|m| lo + s >= m - 1e-9);
                 if fits(180.0) {
                     180.0
                 } else if fits(-180.0) {
@@ -235,7 +236,13 @@ pub fn reverse_course(program: &Program, c: usize, machine: &Machine, dialect: &
 fn swapped_event(e: &Event, dialect: &Dialect, lexed: &Lexed) -> String {
     let _ = lexed;
     match *e {
-        Event::Contact(on) => if on { dialect.contact_off.clone() } else { dialect.contact_on.clone() },
+        Event::Contact(on) => {
+            if on {
+                dialect.contact_off.clone()
+            } else {
+                dialect.contact_on.clone()
+            }
+        }
         Event::Tow(restart, mask) => {
             let code = if restart { &dialect.tow_cut } else { &dialect.tow_restart };
             format!("{code} {}{mask}", dialect.tow_mask_word.to_ascii_uppercase())

@@ -49,7 +49,13 @@ pub fn rewrite(
         return Ok(program.text());
     }
     let crlf = program.lines.iter().filter(|l| l.ends_with('\r')).count() * 2 > program.lines.len();
-    let mut e = Emitter { out: Vec::with_capacity(program.lines.len() + 2 * k), it: Interp::new(dialect, machine)?, dialect, machine, crlf };
+    let mut e = Emitter {
+        out: Vec::with_capacity(program.lines.len() + 2 * k),
+        it: Interp::new(dialect, machine)?,
+        dialect,
+        machine,
+        crlf,
+    };
     for j in 0..program.header_end {
         e.original(program, j)?;
     }
@@ -160,7 +166,12 @@ impl Emitter<'_> {
                     (fmt_num(cur.prog[i] + delta, d.decimals), true)
                 }
             } else {
-                let v = cur.prog[i] + delta;
+                // Writing the target value itself is best when that is a short-way move that
+                // leaves the axis where the original had it (modulo whole turns).
+                let literal = target.prog[i] - cur.prog[i];
+                let lands = (wrap(cur.phys[i] + literal - target.phys[i])).abs() <= 1e-9;
+                let v =
+                    if wraps && literal.abs() <= 180.0 + 1e-9 && lands { target.prog[i] } else { cur.prog[i] + delta };
                 if (v - target.prog[i]).abs() <= 1e-9 {
                     (text_of(target, i), false)
                 } else {

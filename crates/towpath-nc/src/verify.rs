@@ -162,6 +162,7 @@ pub fn verify_parsed(
         return Err(VerifyError::CourseCount { got: opt.courses.len(), expected: k });
     }
     let tol = (0.5 * 10f64.powi(-(dialect.decimals as i32))).max(1e-6);
+    check_header_footer(orig, opt)?;
     let order = match_courses(orig, opt, machine, tol)?;
     check_kept_lines(orig, opt, &order, dialect)?;
 
@@ -197,7 +198,10 @@ pub fn verify_parsed(
             let last_a = w[0].courses.iter().map(|&c| pos[c]).max().unwrap_or(0);
             let first_b = w[1].courses.iter().map(|&c| pos[c]).min().unwrap_or(0);
             if first_b < last_a {
-                return Err(VerifyError::Order(format!("ply {:?} starts before ply {:?} is finished", w[1].label, w[0].label)));
+                return Err(VerifyError::Order(format!(
+                    "ply {:?} starts before ply {:?} is finished",
+                    w[1].label, w[0].label
+                )));
             }
         }
     }
@@ -220,8 +224,10 @@ pub fn verify_parsed(
         inverse[i] = p.course;
     }
     let identity: Vec<usize> = (0..k).collect();
-    let before = measure(orig, machine, &identity);
-    let after = measure(opt, machine, &inverse);
+    let before = measure(orig, machine, &identity, orig.header_end, orig.footer_start);
+    // The optimized program starts with the original's header and ends with its footer.
+    let footer_len = orig.lines.len() - orig.footer_start;
+    let after = measure(opt, machine, &inverse, orig.header_end, opt.lines.len() - footer_len);
     Ok(Verification {
         courses: k,
         reversed: order.iter().filter(|p| p.reversed).count(),
@@ -497,6 +503,28 @@ fn check_kept_lines(orig: &Program, opt: &Program, order: &[Placement], dialect:
     Ok(())
 }
 
+/// The header and the footer must be there, line for line, at the start and the end.
+fn check_header_footer(orig: &Program, opt: &Program) -> Result<(), VerifyError> {
+    let same = |a: &str, b: &str| a.trim_end_matches('\r') == b.trim_end_matches('\r');
+    for j in 0..orig.header_end {
+        if !opt.lines.get(j).is_some_and(|l| same(l, &orig.lines[j])) {
+            return Err(VerifyError::LostLine { line: j + 1, text: orig.lines[j].clone() });
+        }
+    }
+    let footer_len = orig.lines.len() - orig.footer_start;
+    if opt.lines.len() < footer_len + orig.header_end {
+        return Err(VerifyError::LostLine { line: orig.footer_start + 1, text: orig.lines[orig.footer_start].clone() });
+    }
+    let off = opt.lines.len() - footer_len;
+    for j in 0..footer_len {
+        if !same(&opt.lines[off + j], &orig.lines[orig.footer_start + j]) {
+            let line = orig.footer_start + j;
+            return Err(VerifyError::LostLine { line: line + 1, text: orig.lines[line].clone() });
+        }
+    }
+    Ok(())
+}
+
 /// Sweeps the courses in their new order over a grid of the courses laid so far: a course
 /// laid before an overlapping course of an earlier ply is a violation.
 fn check_precedence(orig: &Program, fps: &Footprints, order: &[Placement]) -> Result<(), VerifyError> {
@@ -528,7 +556,13 @@ fn check_precedence(orig: &Program, fps: &Footprints, order: &[Placement]) -> Re
                     if entry.0 > pb {
                         for &(x, qx) in &entry.1 {
                             let px = orig.courses[x as usize].ply;
-                            if px > pb && crate::precedence::quads_overlap(&fps.frame, q, &fps.courses[x as usize].quads[qx as usize]) {
+                            if px > pb
+                                && crate::precedence::quads_overlap(
+                                    &fps.frame,
+                                    q,
+                                    &fps.courses[x as usize].quads[qx as usize],
+                                )
+                            {
                                 return Err(VerifyError::Precedence {
                                     before: orig.course_name(b),
                                     after: orig.course_name(x as usize),
@@ -546,9 +580,23 @@ fn check_precedence(orig: &Program, fps: &Footprints, order: &[Placement]) -> Re
 }
 
 /// Motion of a program under every cost model the machine supports; `course_of[c]` maps the
-/// program's course c to the index it is reported under.
-pub fn measure(p: &Program, machine: &Machine, course_of: &[usize]) -> Vec<Motion> {
-    let regions = p.regions();
+/// program's course c to the index it is reported under. Lines before `header_end` and from
+/// `footer_start` count as header and footer.
+pub fn measure(
+    p: &Program,
+    machine: &Machine,
+    course_of: &[usize],
+    header_end: usize,
+    footer_start: usize,
+) -> Vec<Motion> {
+    let mut regions = p.regions();
+    for (j, r) in regions.iter_mut().enumerate() {
+        if j < header_end {
+            *r = Region::Header;
+        } else if j >= footer_start {
+            *r = Region::Footer;
+        }
+    }
     let mut out = Vec::new();
     for kind in CostKind::ALL {
         let Ok(cost) = MachineCost::new(machine.clone(), kind, StateTable::new(machine.dim())) else {
