@@ -198,7 +198,10 @@ impl Machine {
         for (i, a) in self.axes.iter().enumerate() {
             let key = |k: &str| format!("axis[{i}].{k}");
             if a.label.is_empty() || !a.label.chars().all(|c| c.is_ascii_alphanumeric()) {
-                return Err(invalid(key("label"), format!("{:?} is not a valid axis label (letters and digits)", a.label)));
+                return Err(invalid(
+                    key("label"),
+                    format!("{:?} is not a valid axis label (letters and digits)", a.label),
+                ));
             }
             if let Some(j) = self.axes[..i].iter().position(|b| b.label.eq_ignore_ascii_case(&a.label)) {
                 return Err(invalid(key("label"), format!("axis {:?} is defined twice (also axis[{j}])", a.label)));
@@ -273,7 +276,10 @@ impl Machine {
                     return Err(invalid(key("axis"), format!("no axis is labelled {label:?}")));
                 };
                 if self.axes[i].kind == AxisKind::Mandrel {
-                    return Err(invalid(key("axis"), "the mandrel turns the part, not the head: leave it out of the chain"));
+                    return Err(invalid(
+                        key("axis"),
+                        "the mandrel turns the part, not the head: leave it out of the chain",
+                    ));
                 }
                 if driven[i] {
                     return Err(invalid(key("axis"), format!("axis {label:?} drives two joints")));

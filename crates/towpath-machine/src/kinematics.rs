@@ -37,21 +37,20 @@ impl Kinematics {
     /// Builds the kinematics of a machine, or `None` if it has no DH chain and no X/Y/Z axes.
     pub fn new(m: &Machine) -> Option<Self> {
         let source = if !m.dh.is_empty() {
-            let joints = m
-                .dh
-                .iter()
-                .map(|j| Joint {
-                    a: j.a,
-                    d: j.d,
-                    alpha: j.alpha.to_radians(),
-                    theta: j.theta.to_radians(),
-                    driver: j
-                        .axis
-                        .as_deref()
-                        .and_then(|l| m.axis_index(l))
-                        .map(|i| (i, m.axes[i].kind == AxisKind::Linear)),
-                })
-                .collect();
+            let joints =
+                m.dh.iter()
+                    .map(|j| Joint {
+                        a: j.a,
+                        d: j.d,
+                        alpha: j.alpha.to_radians(),
+                        theta: j.theta.to_radians(),
+                        driver: j
+                            .axis
+                            .as_deref()
+                            .and_then(|l| m.axis_index(l))
+                            .map(|i| (i, m.axes[i].kind == AxisKind::Linear)),
+                    })
+                    .collect();
             Source::Chain { joints, tool: m.tool_offset.unwrap_or([0.0; 3]) }
         } else {
             let find = |l: &str| m.axis_index(l).filter(|&i| m.axes[i].kind == AxisKind::Linear);
@@ -189,8 +188,8 @@ mod tests {
     fn planar_two_link_arm_matches_trigonometry() {
         // Two revolute joints in the plane, links 300 and 200: the tool point is the textbook
         // (l1 cos q1 + l2 cos(q1+q2), l1 sin q1 + l2 sin(q1+q2)).
-        let mut m = Machine::new("arm", vec![Axis::new("A", AxisKind::Rotary), Axis::new("B", AxisKind::Rotary)])
-            .unwrap();
+        let mut m =
+            Machine::new("arm", vec![Axis::new("A", AxisKind::Rotary), Axis::new("B", AxisKind::Rotary)]).unwrap();
         m.dh = vec![
             DhJoint { a: 300.0, d: 0.0, alpha: 0.0, theta: 0.0, axis: Some("A".into()) },
             DhJoint { a: 200.0, d: 0.0, alpha: 0.0, theta: 0.0, axis: Some("B".into()) },

@@ -82,10 +82,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let o = optimize(&text, &machine, &dialect, &opts).map_err(|e| classify(&args.program, e))?;
     write(&args.output, &o.text)?;
-    let name = args.program.file_name().map_or_else(|| args.program.display().to_string(), |n| n.to_string_lossy().into());
+    let name =
+        args.program.file_name().map_or_else(|| args.program.display().to_string(), |n| n.to_string_lossy().into());
     let report = Report::new(&name, &machine, &o, &afp);
     if let Some(path) = &args.report {
-        let body = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("html") || e.eq_ignore_ascii_case("htm")) {
+        let body = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("html") || e.eq_ignore_ascii_case("htm"))
+        {
             let optimized = towpath_nc::parse(&o.text, &machine, &dialect).map_err(|e| classify(&args.output, e))?;
             report.to_html(&o, &optimized, &machine)
         } else {

@@ -40,7 +40,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         VerifyError::Original(e) => exit::bad_input(anyhow::anyhow!("{}: {e}", args.original.display())),
         VerifyError::Optimized(e) => exit::bad_input(anyhow::anyhow!("{}: {e}", args.optimized.display())),
         VerifyError::Setup(e) => exit::bad_input(anyhow::anyhow!("{e}")),
-        e => exit::check_failed(anyhow::anyhow!("{} against {}: {e}", args.optimized.display(), args.original.display())),
+        e => {
+            exit::check_failed(anyhow::anyhow!("{} against {}: {e}", args.optimized.display(), args.original.display()))
+        }
     })?;
     let t = totals(&v);
     if args.json {
@@ -62,7 +64,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         v.reversed,
         if v.precedence_checked { "kept" } else { "not needed (one ply)" }
     );
-    println!("  {:<6} {:>14} {:>14} {:>8} {:>14} {:>14} {:>8}", "cost", "off-part in", "off-part out", "saved", "total in", "total out", "saved");
+    println!(
+        "  {:<6} {:>14} {:>14} {:>8} {:>14} {:>14} {:>8}",
+        "cost", "off-part in", "off-part out", "saved", "total in", "total out", "saved"
+    );
     for x in &t {
         println!(
             "  {:<6} {:>14.1} {:>14.1} {:>7.1}% {:>14.1} {:>14.1} {:>7.1}%   ({})",
