@@ -257,7 +257,8 @@ fn planar(angle: f64, equidistant: bool) -> Vec<PlySpec> {
 
 /// All built-in demo parts.
 pub fn demo_parts() -> Vec<DemoPart> {
-    let r = 300.0;
+    // A barrel section: radius 400 mm, 3 m long.
+    let r = 400.0;
     let circ = 2.0 * std::f64::consts::PI * r;
     let g = gantry();
     let m = mandrel_machine();
@@ -307,7 +308,7 @@ pub fn demo_parts() -> Vec<DemoPart> {
             Some(("Fig. 11", 83.5, 44.6)),
             &m,
             Surface::Cylinder(r),
-            vec![ply("axial", [0.0, 0.0, 1500.0, circ], 0.0)],
+            vec![ply("axial", [0.0, 0.0, 3000.0, circ], 0.0)],
         ),
         part(
             "cylinder-2-plies",
@@ -315,7 +316,7 @@ pub fn demo_parts() -> Vec<DemoPart> {
             Some(("Fig. 12", 83.3, 45.1)),
             &m,
             Surface::Cylinder(r),
-            vec![ply("left band", [0.0, 0.0, 650.0, circ], 0.0), ply("right band", [850.0, 0.0, 1500.0, circ], 0.0)],
+            vec![ply("left band", [0.0, 0.0, 1400.0, circ], 0.0), ply("right band", [1600.0, 0.0, 3000.0, circ], 0.0)],
         ),
         part(
             "cylinder-base-3-pads",
@@ -324,10 +325,10 @@ pub fn demo_parts() -> Vec<DemoPart> {
             &m,
             Surface::Cylinder(r),
             vec![
-                ply("base", [0.0, 0.0, 1500.0, circ], 0.0),
-                ply("pad-up 0 deg", [1100.0, 900.0, 1400.0, 1400.0], 0.0),
-                ply("pad-up 90 deg", [100.0, 100.0, 400.0, 500.0], 90.0),
-                ply("pad-up 45 deg", [600.0, 1000.0, 900.0, 1500.0], 45.0),
+                ply("base", [0.0, 0.0, 3000.0, circ], 0.0),
+                ply("pad-up 0 deg", [2200.0, 1200.0, 2800.0, 1900.0], 0.0),
+                ply("pad-up 90 deg", [200.0, 200.0, 600.0, 900.0], 90.0),
+                ply("pad-up 45 deg", [1200.0, 1400.0, 1800.0, 2100.0], 45.0),
             ],
         ),
     ]

@@ -148,8 +148,13 @@ impl Quad {
 /// A course's footprint.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Footprint {
-    /// The shrunk rectangles (see the module docs), unwrapped along the course.
+    /// The shrunk rectangles (see the module docs), unwrapped along the course: each laid move
+    /// split into pieces no longer than four widths.
     pub quads: Vec<Quad>,
+    /// The whole shrunk rectangle of each laid move (the union of its pieces).
+    pub moves: Vec<Quad>,
+    /// For each piece, its move.
+    pub move_of: Vec<u32>,
     /// The laid centre line as polylines in the frame (unwrapped along the course).
     pub paths: Vec<Vec<[f64; 2]>>,
 }
@@ -261,7 +266,7 @@ pub fn footprints(program: &Program, machine: &Machine, width: Width) -> Result<
                 path.push(a);
             }
             path.push(b);
-            add_quads(&mut fp.quads, a, b, w);
+            add_quads(&mut fp, a, b, w);
         }
         if path.len() > 1 {
             fp.paths.push(path);
@@ -274,7 +279,7 @@ pub fn footprints(program: &Program, machine: &Machine, width: Width) -> Result<
 
 /// Adds the shrunk rectangles of one laid move from `a` to `b` of width `w`, split into pieces
 /// no longer than four widths (so spatial indexes stay tight).
-fn add_quads(out: &mut Vec<Quad>, a: [f64; 2], b: [f64; 2], w: f64) {
+fn add_quads(fp: &mut Footprint, a: [f64; 2], b: [f64; 2], w: f64) {
     let shrink = OVERLAP_TOLERANCE / 2.0;
     let d = [b[0] - a[0], b[1] - a[1]];
     let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
@@ -286,9 +291,12 @@ fn add_quads(out: &mut Vec<Quad>, a: [f64; 2], b: [f64; 2], w: f64) {
     let inner = len - OVERLAP_TOLERANCE;
     let pieces = ((inner / (4.0 * w.max(1e-3))).ceil() as usize).clamp(1, 100_000);
     let piece = inner / pieces as f64;
+    let m = fp.moves.len() as u32;
+    fp.moves.push(Quad { c: [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0], u, hl: inner / 2.0, hw });
     for k in 0..pieces {
         let t = shrink + piece * (k as f64 + 0.5);
-        out.push(Quad { c: [a[0] + u[0] * t, a[1] + u[1] * t], u, hl: piece / 2.0, hw });
+        fp.quads.push(Quad { c: [a[0] + u[0] * t, a[1] + u[1] * t], u, hl: piece / 2.0, hw });
+        fp.move_of.push(m);
     }
 }
 
@@ -315,7 +323,7 @@ mod tests {
 
     fn band(x0: f64, y: f64, x1: f64, w: f64) -> Footprint {
         let mut fp = Footprint::default();
-        add_quads(&mut fp.quads, [x0, y], [x1, y], w);
+        add_quads(&mut fp, [x0, y], [x1, y], w);
         fp
     }
 
@@ -333,10 +341,12 @@ mod tests {
         assert!(!a.overlaps(&band(100.0, 0.0, 200.0, 10.0), &f));
         // Crossing at right angles.
         let mut cross = Footprint::default();
-        add_quads(&mut cross.quads, [50.0, -50.0], [50.0, 50.0], 10.0);
+        add_quads(&mut cross, [50.0, -50.0], [50.0, 50.0], 10.0);
         assert!(a.overlaps(&cross, &f));
         // Long moves are split into short pieces.
         assert_eq!(a.quads.len(), 3);
+        assert_eq!(a.moves.len(), 1);
+        assert_eq!(a.move_of, vec![0, 0, 0]);
     }
 
     #[test]

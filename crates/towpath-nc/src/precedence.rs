@@ -74,8 +74,9 @@ impl Grid {
         Grid { size, rows }
     }
 
-    /// The cells a rectangle overlaps with positive area.
-    pub fn cells(&self, q: &Quad, out: &mut Vec<CellHit>) {
+    /// The cells a rectangle overlaps with positive area; `whole` is the larger rectangle it is
+    /// a piece of, which decides whether a cell is fully covered.
+    pub fn cells(&self, q: &Quad, whole: &Quad, out: &mut Vec<CellHit>) {
         out.clear();
         let (lo, hi) = q.bounds();
         let h = self.rows.map_or(self.size, |r| r.0);
@@ -95,7 +96,7 @@ impl Grid {
                 if !q.overlaps(&cell) {
                     continue;
                 }
-                let full = cell_corners(&cell).iter().all(|p| q.contains(*p));
+                let full = cell_corners(&cell).iter().all(|p| whole.contains(*p));
                 let key = match self.rows {
                     Some((_, n)) => (i, j.rem_euclid(n)),
                     None => (i, j),
@@ -197,8 +198,8 @@ pub fn course_precedence(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<(usize, 
                     let fc = &fps.courses[c];
                     let me = c as u32;
                     sc.list.clear();
-                    for q in &fc.quads {
-                        grid.cells(q, &mut sc.hits);
+                    for (qi, q) in fc.quads.iter().enumerate() {
+                        grid.cells(q, &fc.moves[fc.move_of[qi] as usize], &mut sc.hits);
                         for h in &sc.hits {
                             let Some(stack) = cells.get(&h.key) else { continue };
                             let mut stop: Option<u32> = None;
@@ -258,8 +259,9 @@ pub fn course_precedence(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<(usize, 
         let mut covered: Vec<(i64, i64)> = Vec::new();
         let mut hits = Vec::new();
         for &c in courses {
-            for (qi, q) in fps.courses[c].quads.iter().enumerate() {
-                grid.cells(q, &mut hits);
+            let fc = &fps.courses[c];
+            for (qi, q) in fc.quads.iter().enumerate() {
+                grid.cells(q, &fc.moves[fc.move_of[qi] as usize], &mut hits);
                 for h in &hits {
                     cells.entry(h.key).or_default().push(Entry { course: c as u32, quad: qi as u32, full: h.full });
                     if h.full {
@@ -291,7 +293,7 @@ pub fn precedence_sets(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<Vec<usize>
         let intersects = !sets.is_empty()
             && courses.iter().any(|&c| {
                 fps.courses[c].quads.iter().any(|q| {
-                    grid.cells(q, &mut hits);
+                    grid.cells(q, q, &mut hits);
                     hits.iter().any(|h| {
                         cells.get(&h.key).is_some_and(|stack| {
                             stack.iter().any(|e| {
@@ -310,7 +312,7 @@ pub fn precedence_sets(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<Vec<usize>
         }
         for &c in courses {
             for (qi, q) in fps.courses[c].quads.iter().enumerate() {
-                grid.cells(q, &mut hits);
+                grid.cells(q, q, &mut hits);
                 for h in &hits {
                     cells.entry(h.key).or_default().push(Entry { course: c as u32, quad: qi as u32, full: false });
                 }
@@ -330,10 +332,8 @@ mod tests {
         let d = [b[0] - a[0], b[1] - a[1]];
         let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
         let u = [d[0] / len, d[1] / len];
-        Footprint {
-            quads: vec![Quad { c: [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0], u, hl: len / 2.0, hw: w / 2.0 - 0.005 }],
-            paths: vec![vec![a, b]],
-        }
+        let q = Quad { c: [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0], u, hl: len / 2.0, hw: w / 2.0 - 0.005 };
+        Footprint { quads: vec![q], moves: vec![q], move_of: vec![0], paths: vec![vec![a, b]] }
     }
 
     /// Reachability over the edges, as a set of pairs.
