@@ -16,8 +16,8 @@
 //!
 //! Continuous and mandrel axes take the short way round ([`Machine::short_delta`]). A
 //! [`MachineCost`] holds a table of states and implements [`towpath_seq::CostModel`], so the
-//! sequencing engine can price transitions between them. [`Machine::move_cost`] prices one move
-//! whose per-axis travel is already known (a simulator's view of a program line).
+//! sequencing engine can price transitions between them. [`MachineCost::segment`] prices one
+//! move whose per-axis travel is already known (a simulator's view of a program line).
 //!
 //! This crate knows nothing of programs or G-code.
 

@@ -34,17 +34,30 @@ fn cpu_seconds() -> f64 {
     (ticks(11) + ticks(12)) / 100.0
 }
 
+/// One run on the large part.
+struct BigRun {
+    wall: f64,
+    cpu: f64,
+    timings: towpath_nc::Timings,
+    saved: f64,
+    courses: usize,
+    edges: usize,
+    lines: usize,
+}
+
 struct Args {
     runs: usize,
     time_limit: f64,
     big_time_limit: f64,
     plies: usize,
     courses: usize,
+    big_runs: u64,
     write: Option<String>,
 }
 
 fn args() -> Args {
-    let mut a = Args { runs: 5, time_limit: 1.0, big_time_limit: 3.0, plies: 100, courses: 100, write: None };
+    let mut a =
+        Args { runs: 5, time_limit: 1.0, big_time_limit: 3.0, plies: 100, courses: 100, big_runs: 3, write: None };
     let v: Vec<String> = std::env::args().skip(1).collect();
     let mut i = 0;
     while i < v.len() {
@@ -55,6 +68,7 @@ fn args() -> Args {
             "--big-time-limit" => a.big_time_limit = next.parse().expect("--big-time-limit S"),
             "--plies" => a.plies = next.parse().expect("--plies P"),
             "--courses" => a.courses = next.parse().expect("--courses C"),
+            "--big-runs" => a.big_runs = next.parse().expect("--big-runs N"),
             "--write" => a.write = Some(next),
             other => panic!("unknown argument {other}"),
         }
@@ -82,7 +96,7 @@ fn main() {
     ));
     md.push_str("| part | courses | seed 000 off-part | seed 000 total | towpath off-part (axis) | towpath off-part (tool) | towpath total (tool) | towpath unidirectional off-part (axis) | doherty (seed-000 algorithm) off-part (axis) | time per run |\n");
     md.push_str("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-    for part in demo_parts() {
+    for part in demo_parts().into_iter().filter(|_| a.runs > 0) {
         let mut off_axis = Vec::new();
         let mut off_tool = Vec::new();
         let mut total_tool = Vec::new();
@@ -140,7 +154,7 @@ fn main() {
     let text = stacked_panel(a.plies, a.courses);
     let machine = gantry();
     let mut rows = Vec::new();
-    for run in 0..3 {
+    for run in 0..a.big_runs {
         let opts = OptimizeOptions {
             afp: AfpOptions { bidirectional: true, width: Some(Width::Tow(TOW_WIDTH)), ..AfpOptions::default() },
             time_limit: Some(Duration::from_secs_f64(a.big_time_limit)),
@@ -154,37 +168,36 @@ fn main() {
         let cpu = cpu_seconds() - c0;
         let (b, x) = o.verification.motion(CostKind::Axis).expect("axis cost");
         eprintln!("big run {run}: wall {wall:.2} s, cpu {cpu:.2} s, {:?}", o.timings);
-        rows.push((
+        rows.push(BigRun {
             wall,
             cpu,
-            o.timings.clone(),
-            100.0 * (b.off_part() - x.off_part()) / b.off_part(),
-            o.program.courses.len(),
-            o.afp.edges,
-            o.program.lines.len(),
-        ));
+            timings: o.timings.clone(),
+            saved: 100.0 * (b.off_part() - x.off_part()) / b.off_part(),
+            courses: o.program.courses.len(),
+            edges: o.afp.edges,
+            lines: o.program.lines.len(),
+        });
     }
-    let m = |f: &dyn Fn(&(f64, f64, towpath_nc::Timings, f64, usize, usize, usize)) -> f64| {
-        median(rows.iter().map(f).collect())
-    };
-    let (courses, edges, lines) = (rows[0].4, rows[0].5, rows[0].6);
+    let m = |f: &dyn Fn(&BigRun) -> f64| median(rows.iter().map(f).collect());
+    let (courses, edges, lines) = rows.first().map_or((0, 0, 0), |r| (r.courses, r.edges, r.lines));
     md.push_str(&format!(
         "\n**Large part:** a stacked panel of {} plies (0°/45°/−45°/90°, each ply over all earlier ones) with {courses} \
          courses, {lines} program lines; {edges} precedence edges after reduction. Optimized bidirectional with \
-         a {} s solver limit and verified, median of 3 runs: **{:.2} s wall** ({:.2} s CPU; the benchmark machine \
+         a {} s solver limit and verified, median of {} runs: **{:.2} s wall** ({:.2} s CPU; the benchmark machine \
          has 2 cores shared with other jobs, so wall time varies with its load) — parse {:.2} s, footprints + \
          precedence + reversal + problem {:.2} s, solve {:.2} s, rewrite {:.2} s, verify {:.2} s; off-part saved \
          {:.1} % (axis).\n",
         a.plies,
         a.big_time_limit,
-        m(&|r| r.0),
-        m(&|r| r.1),
-        m(&|r| r.2.parse),
-        m(&|r| r.2.build),
-        m(&|r| r.2.solve),
-        m(&|r| r.2.rewrite),
-        m(&|r| r.2.verify),
-        m(&|r| r.3),
+        rows.len(),
+        m(&|r| r.wall),
+        m(&|r| r.cpu),
+        m(&|r| r.timings.parse),
+        m(&|r| r.timings.build),
+        m(&|r| r.timings.solve),
+        m(&|r| r.timings.rewrite),
+        m(&|r| r.timings.verify),
+        m(&|r| r.saved),
     ));
     md.push_str(
         "\nThe doherty column is for the seed-000 algorithm (its own issue): run it on the same parts through \

@@ -10,7 +10,7 @@ use towpath_machine::{AxisKind, Machine};
 
 use crate::dialect::{Codes, Dialect, EventTiming};
 use crate::error::NcError;
-use crate::lex::{lex, Lexed, Word};
+use crate::lex::{lex, Lexed, NumText, Word};
 
 /// Largest axis value accepted, in mm or degrees.
 pub const MAX_AXIS_VALUE: f64 = 1e7;
@@ -25,7 +25,7 @@ pub struct Modal {
     /// Programmed axis values (the values lines write).
     pub prog: Vec<f64>,
     /// The text of each axis's value as last written in absolute mode (`None` if computed).
-    pub text: Vec<Option<String>>,
+    pub text: Vec<Option<NumText>>,
     /// Physical axis values, unwound (continuous axes may exceed 360°).
     pub phys: Vec<f64>,
     /// Incremental distance mode.
@@ -33,7 +33,7 @@ pub struct Modal {
     /// Modal motion: `Some(true)` rapid, `Some(false)` feed, `None` not yet set.
     pub rapid: Option<bool>,
     /// Modal feed value and its text.
-    pub feed: Option<(f64, String)>,
+    pub feed: Option<(f64, NumText)>,
     /// Roller in contact.
     pub contact: bool,
     /// Tows on, as a bit set.
@@ -197,8 +197,7 @@ impl<'a> Interp<'a> {
                 return Ok(Applied { unknown: true, ..Applied::default() });
             }
         };
-        let mut out = Applied::default();
-        out.marker = self.marker(&lexed.comments);
+        let mut out = Applied { marker: self.marker(&lexed.comments), ..Applied::default() };
 
         let c = &self.codes;
         let mut motion_code: Option<bool> = None;
@@ -283,10 +282,10 @@ impl<'a> Interp<'a> {
             out.modal = true;
         }
         if let Some(f) = feed {
-            if !(f.value > 0.0) {
+            if f.value <= 0.0 || f.value.is_nan() {
                 return Err(NcError::line(n, format!("feed {}{} must be > 0", f.letter, f.text)));
             }
-            self.m.feed = Some((f.value, f.text.clone()));
+            self.m.feed = Some((f.value, f.text));
             out.modal = true;
         }
         for (_, w) in &axes {
@@ -330,7 +329,7 @@ impl<'a> Interp<'a> {
             }
             for (i, w) in &axes {
                 self.m.prog[*i] = w.value;
-                self.m.text[*i] = Some(w.text.clone());
+                self.m.text[*i] = Some(w.text);
             }
             out.set_position = true;
         } else if !axes.is_empty() && passthrough {
@@ -355,11 +354,8 @@ impl<'a> Interp<'a> {
                 out.before = events.clone();
             }
             for (i, w) in &axes {
-                let (target, text) = if self.m.incremental {
-                    (self.m.prog[*i] + w.value, None)
-                } else {
-                    (w.value, Some(w.text.clone()))
-                };
+                let (target, text) =
+                    if self.m.incremental { (self.m.prog[*i] + w.value, None) } else { (w.value, Some(w.text)) };
                 // Physical value: the programmed one plus the set-position offset (kept exact
                 // when there is none), or, for a roll-over controller, the short way round.
                 let offset = self.m.phys[*i] - self.m.prog[*i];

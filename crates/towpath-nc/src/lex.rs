@@ -5,13 +5,55 @@
 
 use std::ops::Range;
 
+/// A number's text as written, stored inline (no allocation). Numbers longer than
+/// [`NumText::MAX`] characters are refused by the lexer.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct NumText {
+    len: u8,
+    bytes: [u8; NumText::MAX],
+}
+
+impl NumText {
+    /// The longest number text kept.
+    pub const MAX: usize = 31;
+
+    /// Stores `s` if it is at most [`NumText::MAX`] bytes long.
+    pub fn new(s: &str) -> Option<Self> {
+        let b = s.as_bytes();
+        if b.len() > Self::MAX {
+            return None;
+        }
+        let mut bytes = [0u8; Self::MAX];
+        bytes[..b.len()].copy_from_slice(b);
+        Some(NumText { len: b.len() as u8, bytes })
+    }
+
+    /// The text.
+    pub fn as_str(&self) -> &str {
+        // Built from a &str, so always valid UTF-8.
+        std::str::from_utf8(&self.bytes[..self.len as usize]).unwrap_or("")
+    }
+}
+
+impl std::fmt::Display for NumText {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl std::fmt::Debug for NumText {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:?}", self.as_str())
+    }
+}
+
 /// A word: a letter and a number, with the number's text as written.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Word {
     /// The letter, upper case.
     pub letter: char,
     /// The number as written (`"010.50"`).
-    pub text: String,
+    pub text: NumText,
     /// The number's value.
     pub value: f64,
     /// Byte range of the whole word (letter and number) in the line.
@@ -87,6 +129,9 @@ pub fn lex(line: &str, parens: bool, semicolon: bool) -> Result<Lexed, LexIssue>
                 return Err(LexIssue { message: format!("word {letter} has no number"), letter: Some(letter) });
             }
             let text = &line[num_start..i];
+            let Some(num) = NumText::new(text) else {
+                return Err(LexIssue { message: format!("{letter}{text} is too long a number"), letter: Some(letter) });
+            };
             let value: f64 = text
                 .parse()
                 .map_err(|_| LexIssue { message: format!("{letter}{text} is not a number"), letter: Some(letter) })?;
@@ -97,7 +142,7 @@ pub fn lex(line: &str, parens: bool, semicolon: bool) -> Result<Lexed, LexIssue>
                 });
             }
             // A letter glued to another letter ("GOTO") is not a word.
-            out.words.push(Word { letter, text: text.to_string(), value, span: start..i });
+            out.words.push(Word { letter, text: num, value, span: start..i });
             continue;
         }
         return Err(LexIssue { message: format!("unexpected character {:?}", c as char), letter: None });
@@ -114,7 +159,7 @@ mod tests {
         let l = lex("N10 G1 X-10.5 Y.25 z 3 F1000 (go) ; rest (x)", true, true).unwrap();
         let w: Vec<(char, f64)> = l.words.iter().map(|w| (w.letter, w.value)).collect();
         assert_eq!(w, vec![('N', 10.0), ('G', 1.0), ('X', -10.5), ('Y', 0.25), ('Z', 3.0), ('F', 1000.0)]);
-        assert_eq!(l.words[2].text, "-10.5");
+        assert_eq!(l.words[2].text.as_str(), "-10.5");
         assert_eq!(&"N10 G1 X-10.5"[l.words[2].span.clone()], "X-10.5");
         assert_eq!(l.comments, vec!["go".to_string(), " rest (x)".to_string()]);
     }
@@ -125,7 +170,8 @@ mod tests {
         assert_eq!(lex("%", true, true).unwrap_err().letter, None);
         assert!(lex("(open", true, true).is_err());
         let huge = format!("X{}", "9".repeat(400));
-        assert!(lex(&huge, true, true).unwrap_err().message.contains("out of range"));
+        assert!(lex(&huge, true, true).unwrap_err().message.contains("too long"));
+        assert!(lex("X9999999999999999", true, true).unwrap_err().message.contains("out of range"));
         // "1e5" is not scientific notation here: it is X1 followed by E5.
         assert_eq!(lex("X1e5", true, true).unwrap().words.len(), 2);
         // Without parenthesis comments a parenthesis is not allowed.

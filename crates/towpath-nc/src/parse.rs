@@ -150,7 +150,9 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
                 }
                 course_ply[c] = plies.len() - 1;
                 course_number[c] = pending_number.take();
-                plies.last_mut().map(|p| p.courses.push(c));
+                if let Some(p) = plies.last_mut() {
+                    p.courses.push(c);
+                }
                 c += 1;
             }
             match &f.marker {

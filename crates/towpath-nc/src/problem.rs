@@ -17,7 +17,7 @@ use crate::footprint::{footprints, Footprints, Width};
 use crate::interp::Interp;
 use crate::precedence::{course_precedence, precedence_sets};
 use crate::program::Program;
-use crate::reverse::{reverse_course, Reversed};
+use crate::reverse::{reversal_of, Reversed};
 
 /// Which precedence to impose.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
@@ -100,7 +100,7 @@ pub struct AfpProblem {
     pub set_plies: Vec<Vec<usize>>,
     /// The original order: every course forward.
     pub original: Vec<Step>,
-    /// The reversed span of every course that has a reverse mode.
+    /// How every course that has a reverse mode reverses (its lines are written when needed).
     pub reversed: Vec<Option<Reversed>>,
     /// Courses that could not be reversed, and why.
     pub not_reversible: Vec<(usize, String)>,
@@ -147,7 +147,7 @@ pub fn build_problem(
     if opts.bidirectional {
         use rayon::prelude::*;
         let all: Vec<Result<Reversed, String>> =
-            (0..k).into_par_iter().map(|c| reverse_course(program, c, machine, dialect)).collect();
+            (0..k).into_par_iter().map(|c| reversal_of(program, c, machine, dialect)).collect();
         for (c, r) in all.into_iter().enumerate() {
             match r {
                 Ok(r) => reversed[c] = Some(r),

@@ -18,7 +18,7 @@ use crate::program::Program;
 /// A course's span, reversed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Reversed {
-    /// The lines of the reversed span.
+    /// The lines of the reversed span (empty from [`reversal_of`]).
     pub lines: Vec<String>,
     /// The state the machine must be in before them (absolute mode).
     pub entry: Modal,
@@ -52,6 +52,22 @@ enum StationItem {
 
 /// Builds the reversed span of course `c`, or says why it cannot be reversed.
 pub fn reverse_course(program: &Program, c: usize, machine: &Machine, dialect: &Dialect) -> Result<Reversed, String> {
+    reverse_span(program, c, machine, dialect, true)
+}
+
+/// Like [`reverse_course`], but without writing the lines (`lines` is left empty): enough to
+/// know whether and how the course reverses.
+pub fn reversal_of(program: &Program, c: usize, machine: &Machine, dialect: &Dialect) -> Result<Reversed, String> {
+    reverse_span(program, c, machine, dialect, false)
+}
+
+fn reverse_span(
+    program: &Program,
+    c: usize,
+    machine: &Machine,
+    dialect: &Dialect,
+    write: bool,
+) -> Result<Reversed, String> {
     let course = &program.courses[c];
     let codes = dialect.codes().map_err(|e| e.to_string())?;
     let mut it = Interp::new(dialect, machine).map_err(|e| e.to_string())?;
@@ -60,7 +76,7 @@ pub fn reverse_course(program: &Program, c: usize, machine: &Machine, dialect: &
 
     // Walk the span: stations (points) with their items, and the moves between them.
     let mut prog: Vec<Vec<f64>> = vec![it.m.prog.clone()];
-    let mut text: Vec<Vec<Option<String>>> = vec![it.m.text.clone()];
+    let mut text: Vec<Vec<Option<crate::lex::NumText>>> = vec![it.m.text.clone()];
     let mut stations: Vec<Vec<StationItem>> = vec![Vec::new()];
     let mut moves: Vec<Move> = Vec::new();
     for j in course.span.clone() {
@@ -84,11 +100,13 @@ pub fn reverse_course(program: &Program, c: usize, machine: &Machine, dialect: &
             let event_text = |evs: &[Event]| -> Vec<StationItem> {
                 evs.iter().map(|e| StationItem::Event(swapped_event(e, dialect, &lexed))).collect()
             };
-            stations.last_mut().map(|s| s.extend(event_text(&a.before)));
+            if let Some(s) = stations.last_mut() {
+                s.extend(event_text(&a.before));
+            }
             moves.push(Move {
                 part,
                 rapid,
-                feed: if rapid { None } else { it.m.feed.as_ref().map(|f| f.1.clone()) },
+                feed: if rapid { None } else { it.m.feed.as_ref().map(|f| f.1.to_string()) },
                 comment: if lexed.comments.is_empty() { None } else { Some(lexed.comments.join(" ")) },
             });
             prog.push(it.m.prog.clone());
@@ -103,14 +121,18 @@ pub fn reverse_course(program: &Program, c: usize, machine: &Machine, dialect: &
                 return Err(format!("line {} has several tow or contact codes", j + 1));
             }
             let item = StationItem::Event(swap_line_code(line, &evs[0], dialect, &codes, &lexed));
-            stations.last_mut().map(|s| s.push(item));
+            if let Some(s) = stations.last_mut() {
+                s.push(item);
+            }
         } else if a.modal {
             if a.unknown {
                 return Err(format!("line {} mixes mode changes with words towpath does not know", j + 1));
             }
             // A pure mode change: the reversed moves carry their own modes.
         } else {
-            stations.last_mut().map(|s| s.push(StationItem::Line(line.to_string())));
+            if let Some(s) = stations.last_mut() {
+                s.push(StationItem::Line(line.to_string()));
+            }
         }
     }
 
@@ -143,7 +165,7 @@ pub fn reverse_course(program: &Program, c: usize, machine: &Machine, dialect: &
     }
     let heading = machine.heading_axis();
     let value_text = |k: usize, i: usize| -> String {
-        let t = text[k][i].as_deref();
+        let t = text[k][i].as_ref().map(|x| x.as_str());
         if Some(i) == heading {
             match t {
                 Some(t) => shift_decimal(t, shift).unwrap_or_else(|| fmt_num(prog[k][i] + shift, dialect.decimals)),
@@ -165,10 +187,11 @@ pub fn reverse_course(program: &Program, c: usize, machine: &Machine, dialect: &
 
     let n = moves.len();
     let mut lines = Vec::new();
+    let stations_to_write = if write { n + 1 } else { 0 };
     let mut cur: Vec<String> = (0..dim).map(|i| value_text(n, i)).collect();
     let mut cur_rapid: Option<bool> = None;
     let mut cur_feed: Option<String> = None;
-    for s in (0..=n).rev() {
+    for s in (0..stations_to_write).rev() {
         for item in stations[s].iter().rev() {
             match item {
                 StationItem::Line(t) | StationItem::Event(t) => lines.push(t.clone()),
@@ -224,7 +247,7 @@ pub fn reverse_course(program: &Program, c: usize, machine: &Machine, dialect: &
     if let Some(h) = heading {
         entry.prog[h] += shift;
         entry.phys[h] += shift;
-        entry.text[h] = Some(value_text(n, h));
+        entry.text[h] = crate::lex::NumText::new(&value_text(n, h));
     }
     entry.incremental = false;
     entry.contact = false;

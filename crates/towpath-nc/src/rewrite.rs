@@ -48,6 +48,25 @@ pub fn rewrite(
     if order.iter().enumerate().all(|(i, p)| p.course == i && !p.reversed) {
         return Ok(program.text());
     }
+    // Write the reversed spans that are needed and not written yet.
+    let written: Vec<(usize, Reversed)> = {
+        use rayon::prelude::*;
+        order
+            .par_iter()
+            .filter(|p| {
+                p.reversed && reversed.get(p.course).and_then(Option::as_ref).is_some_and(|r| r.lines.is_empty())
+            })
+            .map(|p| {
+                crate::reverse::reverse_course(program, p.course, machine, dialect).map(|r| (p.course, r)).map_err(
+                    |why| NcError::Request(format!("{} cannot be reversed: {why}", program.course_name(p.course))),
+                )
+            })
+            .collect::<Result<_, _>>()?
+    };
+    let mut fresh: Vec<Option<&Reversed>> = vec![None; k];
+    for (c, r) in &written {
+        fresh[*c] = Some(r);
+    }
     let crlf = program.lines.iter().filter(|l| l.ends_with('\r')).count() * 2 > program.lines.len();
     let mut e = Emitter {
         out: Vec::with_capacity(program.lines.len() + 2 * k),
@@ -67,7 +86,7 @@ pub fn rewrite(
         }
         e.items(program, &course.pre_before)?;
         let rev = if p.reversed {
-            match reversed.get(p.course).and_then(Option::as_ref) {
+            match fresh[p.course].or_else(|| reversed.get(p.course).and_then(Option::as_ref)) {
                 Some(r) => Some(r),
                 None => return Err(NcError::Request(format!("{} cannot be reversed", program.course_name(p.course)))),
             }
@@ -144,7 +163,7 @@ impl Emitter<'_> {
         let m = self.machine;
         let cur = self.it.m.clone();
         let dim = m.dim();
-        let text_of = |t: &Modal, i: usize| t.text[i].clone().unwrap_or_else(|| fmt_num(t.prog[i], d.decimals));
+        let text_of = |t: &Modal, i: usize| t.text[i].map_or_else(|| fmt_num(t.prog[i], d.decimals), |x| x.to_string());
         let label = |i: usize| m.axes[i].label.to_ascii_uppercase();
         let mut axis_words = Vec::new();
         let mut reset = Vec::new();

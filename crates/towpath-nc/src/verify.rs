@@ -462,11 +462,13 @@ fn must_keep(line: &str, dialect: &Dialect) -> bool {
         return !line.trim().is_empty();
     };
     let codes = [&dialect.contact_on, &dialect.contact_off, &dialect.tow_restart, &dialect.tow_cut];
-    !l.words.iter().any(|w| {
+    let modal_or_event = l.words.iter().any(|w| {
         w.letter == 'G'
             || w.letter.to_string().eq_ignore_ascii_case(&dialect.feed_word)
             || codes.iter().any(|c| crate::dialect::Code::parse(c).is_some_and(|c| c.matches(w.letter, w.value)))
-    }) && !(l.words.is_empty() && l.comments.is_empty())
+    });
+    let blank = l.words.is_empty() && l.comments.is_empty();
+    !modal_or_event && !blank
 }
 
 fn check_kept_lines(orig: &Program, opt: &Program, order: &[Placement], dialect: &Dialect) -> Result<(), VerifyError> {
@@ -538,7 +540,8 @@ fn check_precedence(orig: &Program, fps: &Footprints, order: &[Placement]) -> Re
         _ => cell,
     };
     // cell -> (max ply laid, entries (course, quad))
-    let mut grid: HashMap<(i64, i64), (usize, Vec<(u32, u32)>)> = HashMap::new();
+    type Cell = (usize, Vec<(u32, u32)>);
+    let mut grid: HashMap<(i64, i64), Cell> = HashMap::new();
     let key = |i: i64, j: i64| match rows {
         Some(r) => (i, j.rem_euclid(r)),
         None => (i, j),

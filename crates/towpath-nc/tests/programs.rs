@@ -192,7 +192,7 @@ fn verifier_catches_illegal_reversals() {
     let mut r0 = rev[0].clone().unwrap();
     r0.entry.prog[3] = 0.0;
     r0.entry.phys[3] = 0.0;
-    r0.entry.text[3] = Some("0".into());
+    r0.entry.text[3] = towpath_nc::NumText::new("0");
     let mut rev2 = rev.clone();
     rev2[0] = Some(r0);
     let bad = rewrite(&p, &order, &gantry(), &d, &rev2).unwrap();

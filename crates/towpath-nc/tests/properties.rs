@@ -47,7 +47,7 @@ struct PartSpec {
 
 fn course_spec() -> impl Strategy<Value = CourseSpec> {
     (
-        (0.0f64..300.0, 0.0f64..300.0, 0.0f64..6.28, 20.0f64..250.0),
+        (0.0f64..300.0, 0.0f64..300.0, 0.0f64..std::f64::consts::TAU, 20.0f64..250.0),
         (1usize..5, 0u32..3600, 1u64..16, proptest::option::of((0usize..4, 1u64..16)), 0u8..4),
     )
         .prop_map(|((x, y, angle, len), (points, h, mask, mid, extra))| CourseSpec {
