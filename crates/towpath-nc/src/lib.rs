@@ -29,7 +29,7 @@ pub use error::NcError;
 pub use footprint::{footprints, Footprint, Footprints, Frame, Quad, Width, OVERLAP_TOLERANCE};
 pub use interp::{Event, Interp, Marker, Modal};
 pub use lex::{lex, LexIssue, Lexed, NumText, Word};
-pub use optimize::{apply_steps, optimize, OptimizeOptions, Optimized, SolverSummary, Timings};
+pub use optimize::{apply_steps, auto_time_limit, optimize, OptimizeOptions, Optimized, SolverSummary, Timings};
 pub use parse::parse;
 pub use precedence::{course_precedence, precedence_sets};
 pub use problem::{build_problem, placements, AfpOptions, AfpProblem, PrecedenceRule};

@@ -14,7 +14,7 @@ use crate::rewrite::{rewrite, Placement};
 use crate::verify::{verify_parsed, Verification, VerifyOptions};
 
 /// How to optimize.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct OptimizeOptions {
     /// Problem options (cost, reversal, precedence, width).
     pub afp: AfpOptions,
@@ -26,6 +26,8 @@ pub struct OptimizeOptions {
     pub seed: u64,
     /// Solver threads.
     pub threads: usize,
+    /// Called as the solver progresses.
+    pub progress: Option<towpath_seq::ProgressFn>,
 }
 
 impl Default for OptimizeOptions {
@@ -36,7 +38,26 @@ impl Default for OptimizeOptions {
             iterations: None,
             seed: 1,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            progress: None,
         }
+    }
+}
+
+/// A solver time limit for a program of `courses` courses when none is given: one second plus
+/// a millisecond per course, at most ten seconds.
+pub fn auto_time_limit(courses: usize) -> Duration {
+    Duration::from_secs_f64((1.0 + 0.001 * courses as f64).min(10.0))
+}
+
+impl std::fmt::Debug for OptimizeOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("OptimizeOptions")
+            .field("afp", &self.afp)
+            .field("time_limit", &self.time_limit)
+            .field("iterations", &self.iterations)
+            .field("seed", &self.seed)
+            .field("threads", &self.threads)
+            .finish()
     }
 }
 
@@ -115,6 +136,7 @@ pub fn optimize(
             seed: opts.seed,
             threads: opts.threads.max(1),
             initial: Some(afp.original.clone()),
+            progress: opts.progress.clone(),
             ..SolveOptions::default()
         },
     )?;

@@ -7,7 +7,8 @@
 //! motion mode, feed) in which the original program entered the second, so the second runs
 //! exactly as it did. Continuous and mandrel axes move the short way round; when that leaves a
 //! programmed value that differs from the original by whole turns, a set-position line
-//! re-declares the original value. In the original order the output is the input, unchanged.
+//! re-declares the original value. Each ply comment moves to where its ply first starts and is
+//! repeated where the ply starts again. In the original order the output is the input, unchanged.
 
 use towpath_machine::Machine;
 
@@ -69,6 +70,8 @@ pub fn rewrite(
     }
     let crlf = program.lines.iter().filter(|l| l.ends_with('\r')).count() * 2 > program.lines.len();
     let mut e = Emitter {
+        moved: Vec::new(),
+        marker_of_line: Vec::new(),
         out: Vec::with_capacity(program.lines.len() + 2 * k),
         it: Interp::new(dialect, machine)?,
         dialect,
@@ -79,10 +82,36 @@ pub fn rewrite(
         e.original(program, j)?;
     }
     let mut prev: Option<usize> = None;
+    // Ply comments: each moves to where its ply first starts and is repeated where the ply
+    // starts again, so the output reads ply by ply and, read again, divides into plies that
+    // agree with its order.
+    let mut marker_of_line: Vec<Option<usize>> = vec![None; program.lines.len()];
+    for (x, ply) in program.plies.iter().enumerate() {
+        if let Some(j) = ply.line {
+            marker_of_line[j] = Some(x);
+        }
+    }
+    e.moved = vec![false; program.plies.len()];
+    e.marker_of_line = marker_of_line;
     for p in order {
         let course = &program.courses[p.course];
         if let Some(pc) = prev {
             e.items(program, &program.courses[pc].post)?;
+        }
+        let prev_ply = prev.map(|pc| program.courses[pc].ply);
+        if prev_ply != Some(course.ply) {
+            let ply = &program.plies[course.ply];
+            match ply.line {
+                Some(j) if !e.moved[course.ply] => {
+                    e.moved[course.ply] = true;
+                    e.original(program, j)?;
+                }
+                Some(j) => e.generated(program.lines[j].trim_end_matches('\r').to_string())?,
+                None if prev_ply.is_some() => e.generated(
+                    dialect.comment(&format!("{} 0 (courses before the first ply comment)", dialect.ply_comment)),
+                )?,
+                None => {}
+            }
         }
         e.items(program, &course.pre_before)?;
         let rev = if p.reversed {
@@ -120,6 +149,10 @@ pub fn rewrite(
 }
 
 struct Emitter<'a> {
+    /// Ply comments already written at the start of their ply.
+    moved: Vec<bool>,
+    /// The ply whose comment each line is, if any.
+    marker_of_line: Vec<Option<usize>>,
     out: Vec<String>,
     it: Interp<'a>,
     dialect: &'a Dialect,
@@ -150,7 +183,13 @@ impl Emitter<'_> {
     fn items(&mut self, program: &Program, items: &[Item]) -> Result<(), NcError> {
         for item in items {
             match item {
-                Item::Line(j) => self.original(program, *j)?,
+                Item::Line(j) => {
+                    // A ply comment written at the start of its ply is not written again.
+                    match self.marker_of_line.get(*j).copied().flatten() {
+                        Some(x) if self.moved.get(x).copied().unwrap_or(false) => {}
+                        _ => self.original(program, *j)?,
+                    }
+                }
                 Item::Kept(_, text) => self.generated(text.clone())?,
             }
         }

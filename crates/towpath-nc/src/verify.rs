@@ -2,8 +2,8 @@
 //! optimizer (it shares only the parser and the footprint geometry).
 //!
 //! It checks that the optimized program lays the same multiset of courses, each either with
-//! its span byte-identical and the same motion (points, tows on, feeds), or as a legal
-//! reversal (the same points in reverse order, the heading axis turned by 180°, the same tows
+//! the same motion (points, tows on, feeds; its span byte-identical, or, if written anew,
+//! keeping its comments and unknown lines), or as a legal reversal (the same points in reverse order, the heading axis turned by 180°, the same tows
 //! on along every move, the same feeds on-part); that every line the original keeps (header,
 //! footer, comments and unknown lines) is still there; and that no course is laid before a
 //! course of an earlier ply it overlaps. It measures the off-part and on-part motion of both
@@ -163,8 +163,8 @@ pub fn verify_parsed(
     }
     let tol = (0.5 * 10f64.powi(-(dialect.decimals as i32))).max(1e-6);
     check_header_footer(orig, opt)?;
-    let order = match_courses(orig, opt, machine, tol)?;
-    check_kept_lines(orig, opt, &order, dialect)?;
+    let (order, rewritten) = match_courses(orig, opt, machine, tol)?;
+    check_kept_lines(orig, opt, &order, &rewritten, dialect)?;
 
     // Precedence.
     let plies_with_courses = orig.plies.iter().filter(|p| !p.courses.is_empty()).count();
@@ -384,19 +384,40 @@ fn neighbour_cells(cell: &[(i64, Option<i64>)]) -> Vec<Vec<i64>> {
     out
 }
 
-fn match_courses(orig: &Program, opt: &Program, machine: &Machine, tol: f64) -> Result<Vec<Placement>, VerifyError> {
+/// Matches every course of `opt` to a course of `orig`: by identical span text and motion, else
+/// by identical motion (written differently), else as a legal reversal. Returns the placements
+/// and, per placement, whether its lines were written anew (reversed, or rewritten forward).
+fn match_courses(
+    orig: &Program,
+    opt: &Program,
+    machine: &Machine,
+    tol: f64,
+) -> Result<(Vec<Placement>, Vec<bool>), VerifyError> {
     let k = orig.courses.len();
     let mut by_text: HashMap<String, Vec<usize>> = HashMap::new();
     for c in (0..k).rev() {
         by_text.entry(span_text(orig, c)).or_default().push(c);
     }
     let mut by_end: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
+    let mut by_start: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
     for c in (0..k).rev() {
         let key: Vec<i64> = point_cell(machine, &orig.courses[c].exit.phys).iter().map(|x| x.0).collect();
         by_end.entry(key).or_default().push(c);
+        let key: Vec<i64> = point_cell(machine, &orig.courses[c].span_start.phys).iter().map(|x| x.0).collect();
+        by_start.entry(key).or_default().push(c);
     }
+    let near = |map: &HashMap<Vec<i64>, Vec<usize>>, p: &[f64]| -> Vec<usize> {
+        let mut v: Vec<usize> = neighbour_cells(&point_cell(machine, p))
+            .iter()
+            .filter_map(|key| map.get(key))
+            .flat_map(|v| v.iter().copied())
+            .collect();
+        v.sort_unstable();
+        v
+    };
     let mut used = vec![false; k];
     let mut order = Vec::with_capacity(k);
+    let mut rewritten = Vec::with_capacity(k);
     for kc in 0..k {
         let text = span_text(opt, kc);
         let mut found = None;
@@ -415,14 +436,18 @@ fn match_courses(orig: &Program, opt: &Program, machine: &Machine, tol: f64) -> 
                 }
             }
         }
+        let by_text = found.is_some();
+        let start = &opt.courses[kc].span_start.phys;
         if found.is_none() {
-            let start = &opt.courses[kc].span_start.phys;
-            let mut cands: Vec<usize> = neighbour_cells(&point_cell(machine, start))
-                .iter()
-                .filter_map(|key| by_end.get(key))
-                .flat_map(|v| v.iter().copied())
-                .collect();
-            cands.sort_unstable();
+            for oc in near(&by_start, start) {
+                if !used[oc] && is_forward(orig, oc, opt, kc, machine, tol).is_ok() {
+                    found = Some(Placement { course: oc, reversed: false });
+                    break;
+                }
+            }
+        }
+        if found.is_none() {
+            let cands = near(&by_end, start);
             if cands.is_empty() && detail.is_empty() {
                 detail = ": no course of the original ends where it starts".into();
             }
@@ -444,6 +469,7 @@ fn match_courses(orig: &Program, opt: &Program, machine: &Machine, tol: f64) -> 
         match found {
             Some(p) => {
                 used[p.course] = true;
+                rewritten.push(!by_text);
                 order.push(p);
             }
             None => return Err(VerifyError::Unmatched { line: opt.courses[kc].on_part.start + 1, detail }),
@@ -452,7 +478,7 @@ fn match_courses(orig: &Program, opt: &Program, machine: &Machine, tol: f64) -> 
     if let Some(c) = used.iter().position(|u| !u) {
         return Err(VerifyError::Missing(orig.course_name(c)));
     }
-    Ok(order)
+    Ok((order, rewritten))
 }
 
 /// A line that must survive: not a move, and no tow, contact or mode codes (those are checked
@@ -471,7 +497,13 @@ fn must_keep(line: &str, dialect: &Dialect) -> bool {
     !modal_or_event && !blank
 }
 
-fn check_kept_lines(orig: &Program, opt: &Program, order: &[Placement], dialect: &Dialect) -> Result<(), VerifyError> {
+fn check_kept_lines(
+    orig: &Program,
+    opt: &Program,
+    order: &[Placement],
+    rewritten: &[bool],
+    dialect: &Dialect,
+) -> Result<(), VerifyError> {
     let mut have: HashMap<&str, usize> = HashMap::new();
     for l in &opt.lines {
         *have.entry(l.trim_end_matches('\r')).or_default() += 1;
@@ -488,7 +520,7 @@ fn check_kept_lines(orig: &Program, opt: &Program, order: &[Placement], dialect:
             }
         }
     }
-    for p in order.iter().filter(|p| p.reversed) {
+    for (p, _) in order.iter().zip(rewritten).filter(|(_, r)| **r) {
         for j in orig.courses[p.course].span.clone() {
             if orig.line_segment[j].is_none() && must_keep(&orig.lines[j], dialect) {
                 need.push((j, orig.lines[j].clone()));

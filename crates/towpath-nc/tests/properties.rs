@@ -235,6 +235,31 @@ proptest! {
     }
 
     #[test]
+    fn optimizing_the_output_again_still_verifies_against_the_original(spec in part_spec()) {
+        let text = program(&spec);
+        let d = Dialect::default();
+        let opts = |seed| OptimizeOptions {
+            afp: AfpOptions { bidirectional: true, width: Some(Width::Tow(6.0)), ..AfpOptions::default() },
+            time_limit: None,
+            iterations: Some(100),
+            threads: 1,
+            seed,
+            ..OptimizeOptions::default()
+        };
+        let once = optimize(&text, &machine(), &d, &opts(1)).unwrap();
+        // Read again, the output's plies each hold courses of one original ply.
+        let reread = parse(&once.text, &machine(), &d).unwrap();
+        for ply in &reread.plies {
+            let origin: std::collections::BTreeSet<usize> =
+                ply.courses.iter().map(|&k| once.program.courses[once.order[k].course].ply).collect();
+            prop_assert!(origin.len() <= 1, "{:?}", origin);
+        }
+        let twice = optimize(&once.text, &machine(), &d, &opts(2)).unwrap();
+        let v = verify(&text, &twice.text, &machine(), &d, &VerifyOptions { width: Some(Width::Tow(6.0)), ..VerifyOptions::default() });
+        prop_assert!(v.is_ok(), "{:?}", v.err());
+    }
+
+    #[test]
     fn parser_never_panics_on_line_soup(lines in proptest::collection::vec(
         prop_oneof![
             Just("G0 X10 Y10 Z5 C0".to_string()),

@@ -31,9 +31,9 @@ pub struct Args {
     /// Keep the order of the courses within each ply.
     #[arg(long)]
     pub keep_ply_order: bool,
-    /// Solver time limit in seconds.
-    #[arg(long, default_value_t = 10.0, value_name = "S")]
-    pub time_limit: f64,
+    /// Solver time limit in seconds (default: 1 s plus 1 ms per course, at most 10 s).
+    #[arg(long, value_name = "S")]
+    pub time_limit: Option<f64>,
     /// Solver seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -61,8 +61,10 @@ pub fn classify(file: &std::path::Path, e: NcError) -> anyhow::Error {
 
 /// Runs `towpath optimize`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    if !(args.time_limit.is_finite() && args.time_limit >= 0.0) {
-        return Err(exit::bad_input(anyhow::anyhow!("--time-limit {}: give a number of seconds ≥ 0", args.time_limit)));
+    if let Some(t) = args.time_limit {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(exit::bad_input(anyhow::anyhow!("--time-limit {t}: give a number of seconds ≥ 0")));
+        }
     }
     let (machine, dialect, width) = args.machine.load()?;
     let text = read(&args.program)?;
@@ -73,14 +75,34 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         keep_ply_order: args.keep_ply_order,
         width,
     };
+    // The course count decides the default time limit; count roller contacts cheaply.
+    let time_limit = match args.time_limit {
+        Some(t) => Duration::from_secs_f64(t),
+        None => {
+            let courses = text.lines().filter(|l| l.contains(dialect.contact_on.as_str())).count().max(1);
+            towpath_nc::auto_time_limit(if dialect.contact_on.is_empty() { 1000 } else { courses })
+        }
+    };
+    let bar = progress_bar(time_limit);
     let opts = OptimizeOptions {
         afp: afp.clone(),
-        time_limit: Some(Duration::from_secs_f64(args.time_limit)),
+        time_limit: Some(time_limit),
         seed: args.seed,
         threads: args.threads.unwrap_or_else(|| OptimizeOptions::default().threads),
+        progress: bar.clone().map(|b| {
+            let f: towpath_seq::ProgressFn = std::sync::Arc::new(move |p: &towpath_seq::Progress| {
+                b.set_position((p.fraction * 1000.0) as u64);
+                b.set_message(format!("best {:.1}", p.best_cost));
+            });
+            f
+        }),
         ..OptimizeOptions::default()
     };
-    let o = optimize(&text, &machine, &dialect, &opts).map_err(|e| classify(&args.program, e))?;
+    let o = optimize(&text, &machine, &dialect, &opts).map_err(|e| classify(&args.program, e));
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let o = o?;
     write(&args.output, &o.text)?;
     let name =
         args.program.file_name().map_or_else(|| args.program.display().to_string(), |n| n.to_string_lossy().into());
@@ -102,4 +124,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         println!("  written to {}", args.output.display());
     }
     Ok(())
+}
+
+/// A progress bar on stderr, only when it is a terminal.
+fn progress_bar(limit: Duration) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let b = indicatif::ProgressBar::new(1000);
+    let style = indicatif::ProgressStyle::with_template("sequencing {bar:30} {msg} ({elapsed} of ~{prefix})")
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+    b.set_style(style);
+    b.set_prefix(format!("{:.0}s", limit.as_secs_f64()));
+    Some(b)
 }
