@@ -57,7 +57,7 @@ struct Args {
 
 fn args() -> Args {
     let mut a =
-        Args { runs: 5, time_limit: 1.0, big_time_limit: 3.0, plies: 100, courses: 100, big_runs: 3, write: None };
+        Args { runs: 5, time_limit: 1.0, big_time_limit: 2.0, plies: 100, courses: 100, big_runs: 3, write: None };
     let v: Vec<String> = std::env::args().skip(1).collect();
     let mut i = 0;
     while i < v.len() {

@@ -132,8 +132,16 @@ pub fn rewrite(
                 }
             }
             None => {
+                // The span runs exactly as in the original (the transit restored its entry
+                // state), so its lines are copied and the machine state after it is the
+                // original's, with continuous axes as many turns apart as they were before it.
+                let shift: Vec<f64> = (0..machine.dim()).map(|i| e.it.m.phys[i] - course.span_start.phys[i]).collect();
                 for j in course.span.clone() {
-                    e.original(program, j)?;
+                    e.out.push(program.lines[j].clone());
+                }
+                e.it.m = course.exit.clone();
+                for (i, d) in shift.iter().enumerate() {
+                    e.it.m.phys[i] += d;
                 }
             }
         }

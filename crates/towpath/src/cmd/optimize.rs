@@ -31,7 +31,7 @@ pub struct Args {
     /// Keep the order of the courses within each ply.
     #[arg(long)]
     pub keep_ply_order: bool,
-    /// Solver time limit in seconds (default: 1 s plus 1 ms per course, at most 10 s).
+    /// Solver time limit in seconds (default: 1 s plus 0.2 ms per course, at most 10 s).
     #[arg(long, value_name = "S")]
     pub time_limit: Option<f64>,
     /// Solver seed.
