@@ -147,6 +147,14 @@ impl Program {
         &self.points[a..a + self.dim]
     }
 
+    /// Every point in R³ (the tool point in the part frame), if the machine has kinematics;
+    /// indexed like [`Program::points`].
+    pub fn part_points(&self, machine: &towpath_machine::Machine) -> Option<Vec<[f64; 3]>> {
+        let kin = machine.kinematics()?;
+        let n = self.points.len() / self.dim.max(1);
+        Some((0..n as u32).map(|i| kin.part_point(self.point(i))).collect())
+    }
+
     /// Which region each line belongs to.
     pub fn regions(&self) -> Vec<Region> {
         let mut r = vec![Region::Footer; self.lines.len()];

@@ -342,3 +342,80 @@ fn mandrel_moves_the_short_way_round() {
     // The original unwinds 340° between courses twice; the rewrite turns 20° instead.
     assert!(b.off_part() - a.off_part() > 2.0 * 300.0, "{} -> {}", b.off_part(), a.off_part());
 }
+
+/// A two-link arm (shoulder U, elbow V), a vertical slide W and a heading C: the tool point
+/// comes from the DH chain, and footprints, precedence and the tool cost follow it.
+#[test]
+fn robot_with_a_dh_chain() {
+    use towpath_machine::DhJoint;
+    let (l1, l2) = (700.0, 500.0);
+    let mut c = Axis::new("C", AxisKind::Continuous);
+    c.heading = true;
+    let mut m = Machine::new(
+        "arm",
+        vec![Axis::new("U", AxisKind::Rotary), Axis::new("V", AxisKind::Rotary), Axis::new("W", AxisKind::Linear), c],
+    )
+    .unwrap();
+    m.dh = vec![
+        DhJoint { a: 0.0, d: 0.0, alpha: 0.0, theta: 0.0, axis: Some("W".into()) },
+        DhJoint { a: l1, d: 0.0, alpha: 0.0, theta: 0.0, axis: Some("U".into()) },
+        DhJoint { a: l2, d: 0.0, alpha: 0.0, theta: 0.0, axis: Some("V".into()) },
+    ];
+    m.validate().unwrap();
+    // Inverse kinematics of the arm (elbow down) for a point in the plane.
+    let ik = |x: f64, y: f64| {
+        let c2 = (x * x + y * y - l1 * l1 - l2 * l2) / (2.0 * l1 * l2);
+        let q2 = c2.clamp(-1.0, 1.0).acos();
+        let q1 = y.atan2(x) - (l2 * q2.sin()).atan2(l1 + l2 * q2.cos());
+        (q1.to_degrees(), q2.to_degrees())
+    };
+    let w = |x: f64, y: f64, z: f64| {
+        let (u, v) = ik(x, y);
+        format!("U{:.4} V{:.4} W{z}", u, v)
+    };
+    let course = |n: usize, y: f64, x0: f64, x1: f64| {
+        let mut s = format!("(COURSE {n})\nG0 {} C0\nG1 {} F1000\nM20\nM60 P3\n", w(x0, y, 20.0), w(x0, y, 0.0));
+        for k in 1..=4 {
+            let x = x0 + (x1 - x0) * k as f64 / 4.0;
+            s.push_str(&format!("G1 {} F2000\n", w(x, y, 0.0)));
+        }
+        s.push_str(&format!("M61 P3\nM21\nG1 {} F1000\n", w(x1, y, 20.0)));
+        s
+    };
+    let text = format!(
+        "G90\n(PLY 1)\n{}{}{}(PLY 2)\n{}M30\n",
+        course(1, 300.0, 400.0, 800.0),
+        course(2, 340.0, 400.0, 800.0),
+        course(3, 380.0, 400.0, 800.0),
+        course(1, 340.0, 500.0, 700.0)
+    );
+    let d = Dialect::default();
+    let p = parse(&text, &m, &d).unwrap();
+    // The DH chain puts the first laid point where the inverse kinematics aimed.
+    let pts = p.part_points(&m).unwrap();
+    let first = pts[p.on_part_segments(0).next().unwrap().from as usize];
+    assert!((first[0] - 400.0).abs() < 1e-2 && (first[1] - 300.0).abs() < 1e-2, "{first:?}");
+    let o = AfpOptions { width: Some(Width::Course(40.0)), cost: CostKind::Tool, ..AfpOptions::default() };
+    let afp = build_problem(&p, &m, &d, &o).unwrap();
+    // The pad course (y 340, 40 wide) overlaps only base course 2 (y 340).
+    let preds: Vec<u32> = afp.problem.precedence().predecessors(towpath_seq::TaskId(3)).iter().map(|t| t.0).collect();
+    assert_eq!(preds, vec![1]);
+    let mut opts = opts(true);
+    opts.afp = AfpOptions { bidirectional: true, ..o };
+    let r = optimize(&text, &m, &d, &opts).unwrap();
+    let (b, a) = r.verification.motion(CostKind::Tool).unwrap();
+    assert!(a.off_part() < b.off_part());
+}
+
+#[test]
+fn other_approach_and_retract_counts() {
+    for (approach, retract) in [(0, 0), (2, 0), (0, 2), (3, 3)] {
+        let d = Dialect { approach_moves: approach, retract_moves: retract, ..Dialect::default() };
+        let text = program();
+        let p = parse(&text, &gantry(), &d).unwrap();
+        let order: Vec<Placement> = (0..p.courses.len()).map(|c| Placement { course: c, reversed: false }).collect();
+        assert_eq!(rewrite(&p, &order, &gantry(), &d, &[]).unwrap(), text);
+        let o = optimize(&text, &gantry(), &d, &opts(true)).unwrap();
+        verify(&text, &o.text, &gantry(), &d, &vopts()).unwrap();
+    }
+}
