@@ -547,7 +547,8 @@ fn check_header_footer(orig: &Program, opt: &Program) -> Result<(), VerifyError>
     }
     let footer_len = orig.lines.len() - orig.footer_start;
     if opt.lines.len() < footer_len + orig.header_end {
-        return Err(VerifyError::LostLine { line: orig.footer_start + 1, text: orig.lines[orig.footer_start].clone() });
+        let j = orig.footer_start.min(orig.lines.len().saturating_sub(1));
+        return Err(VerifyError::LostLine { line: j + 1, text: orig.lines.get(j).cloned().unwrap_or_default() });
     }
     let off = opt.lines.len() - footer_len;
     for j in 0..footer_len {

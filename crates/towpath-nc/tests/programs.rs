@@ -419,3 +419,15 @@ fn other_approach_and_retract_counts() {
         verify(&text, &o.text, &gantry(), &d, &vopts()).unwrap();
     }
 }
+
+#[test]
+fn verifier_refuses_truncated_and_foreign_programs_without_panicking() {
+    let d = Dialect::default();
+    let text = program();
+    let v = |other: &str| verify(&text, other, &gantry(), &d, &vopts());
+    assert!(matches!(v("").unwrap_err(), VerifyError::Optimized(_)));
+    assert!(v("(PLY 1)\nG0 X0 Y0 Z20 C0\nM20\nM21\n").is_err());
+    let (_, out) = optimized(true);
+    let cut: Vec<&str> = out.lines().take(out.lines().count() - 2).collect();
+    assert!(matches!(v(&cut.join("\n")).unwrap_err(), VerifyError::LostLine { .. }));
+}

@@ -260,6 +260,40 @@ proptest! {
     }
 
     #[test]
+    fn verifier_never_panics_on_mutated_output(spec in part_spec(), edits in proptest::collection::vec((0usize..10_000, 0u8..4, any::<char>()), 1..4)) {
+        let text = program(&spec);
+        let d = Dialect::default();
+        let opts = OptimizeOptions {
+            afp: AfpOptions { bidirectional: true, width: Some(Width::Tow(6.0)), ..AfpOptions::default() },
+            time_limit: None,
+            iterations: Some(50),
+            threads: 1,
+            ..OptimizeOptions::default()
+        };
+        let out = optimize(&text, &machine(), &d, &opts).unwrap().text;
+        let mut lines: Vec<String> = out.lines().map(str::to_string).collect();
+        for (at, kind, ch) in edits {
+            if lines.is_empty() {
+                break;
+            }
+            let i = at % lines.len();
+            match kind {
+                0 => { lines.remove(i); }
+                1 => { let l = lines[i].clone(); lines.insert(i, l); }
+                2 => { if i + 1 < lines.len() { lines.swap(i, i + 1); } }
+                _ => { let mut l: Vec<char> = lines[i].chars().collect(); let k = at % (l.len() + 1); l.insert(k, ch); lines[i] = l.into_iter().collect(); }
+            }
+        }
+        let mutated = lines.join("\n");
+        let r = verify(&text, &mutated, &machine(), &d, &VerifyOptions { width: Some(Width::Tow(6.0)), ..VerifyOptions::default() });
+        // Removing or duplicating a line of motion is always caught.
+        if r.is_ok() {
+            let p = parse(&mutated, &machine(), &d).unwrap();
+            prop_assert_eq!(p.courses.len(), spec.plies.iter().map(Vec::len).sum::<usize>());
+        }
+    }
+
+    #[test]
     fn parser_never_panics_on_line_soup(lines in proptest::collection::vec(
         prop_oneof![
             Just("G0 X10 Y10 Z5 C0".to_string()),
