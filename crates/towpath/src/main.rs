@@ -17,13 +17,17 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run the built-in demo: a generated part, sequenced and checked, with no files of your own.
+    /// Run the built-in demo: seed 000's AFP parts written, optimized, verified and reported.
     Demo(cmd::demo::Args),
     /// Solve a TSPLIB (TSP, ATSP, SOP), GTSP-LIB, PCGLNS or towpath JSON problem file.
     Solve(cmd::solve::Args),
     /// Generate the fiber courses of a ply on a mold surface (mesh or analytic), trimmed per tow,
     /// with quality figures; write JSON, CSV and G-code.
     Layup(Box<cmd::layup::Args>),
+    /// Re-sequence an AFP program: same part, laid identically, less off-part motion, verified.
+    Optimize(cmd::optimize::Args),
+    /// Check an optimized AFP program against its original and print the savings.
+    Verify(cmd::verify::Args),
 }
 
 fn main() {
@@ -32,6 +36,8 @@ fn main() {
         Command::Demo(args) => cmd::demo::run(args),
         Command::Solve(args) => cmd::solve::run(args),
         Command::Layup(args) => cmd::layup::run(*args),
+        Command::Optimize(args) => cmd::optimize::run(args),
+        Command::Verify(args) => cmd::verify::run(args),
     };
     std::process::exit(exit::report(result));
 }
