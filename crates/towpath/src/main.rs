@@ -19,12 +19,15 @@ struct Cli {
 enum Command {
     /// Run the built-in demo: a generated part, sequenced and checked, with no files of your own.
     Demo(cmd::demo::Args),
+    /// Integrate separate tool paths into one open route over a travel graph (seed 004's open rural postman).
+    Route(cmd::route::Args),
 }
 
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Demo(args) => cmd::demo::run(args),
+        Command::Route(args) => cmd::route::run(args),
     };
     std::process::exit(exit::report(result));
 }
