@@ -99,3 +99,40 @@ fn generated_instances_are_saved_and_reread() {
     let i = read_instance(&text).unwrap();
     assert_eq!((i.vertices().len(), i.required().len()), (20, 10));
 }
+
+#[test]
+fn every_solver_gives_a_valid_walk() {
+    let path = fixture("rpp_6re.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let exact = {
+        let m = RppModel::new(read_instance(&text).unwrap()).unwrap();
+        towpath_seq::solve_exact(m.problem()).unwrap().unwrap().cost
+    };
+    for solver in ["towpath", "doherty", "castelino", "ga", "aco1", "aco2", "aco"] {
+        let out = towpath()
+            .args([
+                "route",
+                path.to_str().unwrap(),
+                "--json",
+                "--time-limit",
+                "2",
+                "--threads",
+                "1",
+                "--solver",
+                solver,
+            ])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{solver}: {}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let walk: Vec<u64> = v["walk"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect();
+        let edges: Vec<u64> = v["walk_edges"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect();
+        let len = walk_length(&text, &walk, &edges);
+        assert!(len >= exact - 1e-9, "{solver}: {len} below the optimum {exact}");
+        assert!((v["length"].as_f64().unwrap() - len).abs() < 1e-9, "{solver}");
+        let name = if solver == "aco" { "aco2" } else { solver };
+        assert_eq!(v["solver"], name);
+    }
+    let out = towpath().args(["route", path.to_str().unwrap(), "--solver", "lkh"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}

@@ -2,3 +2,4 @@
 
 pub mod demo;
 pub mod route;
+pub mod solver_args;

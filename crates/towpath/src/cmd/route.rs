@@ -6,14 +6,16 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::Context;
+use towpath_baselines::{solve_with, BaselineError};
 use towpath_coverage::{read_instance, seed004_like, verify_route, write_instance, Instance, RouteJson, RppModel};
 use towpath_seq::SolveOptions;
 
+use crate::cmd::solver_args::SolverArgs;
 use crate::exit;
 
 /// Arguments of `towpath route`.
 #[derive(clap::Args, Debug)]
-#[command(long_about = "Integrates separate tool paths into one open route (seed 004's open rural postman \
+#[command(after_long_help = "Integrates separate tool paths into one open route (seed 004's open rural postman \
 problem). The input is a travel graph in JSON: vertices with coordinates, undirected edges with lengths, \
 some edges marked \"required\" (each a tool path to be done once, in either direction). The tool travels \
 between required edges along shortest paths. The output is the full vertex walk, including connecting paths.
@@ -36,7 +38,8 @@ pub struct Args {
     /// Write the instance (read or generated) to this JSON file.
     #[arg(long, value_name = "FILE")]
     pub save_instance: Option<PathBuf>,
-    /// Time limit for the solver, in seconds.
+    /// Time limit for the solver, in seconds (the seed papers' solvers run their own budgets and
+    /// stop early only if this passes).
     #[arg(long, default_value_t = 10.0)]
     pub time_limit: f64,
     /// Seed for the solver's random choices (same seed, same answer under a work budget).
@@ -51,6 +54,8 @@ pub struct Args {
     /// Print one JSON object (the route) instead of a summary.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub solver: SolverArgs,
 }
 
 /// Runs `towpath route`.
@@ -68,10 +73,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(t) = args.threads {
         opts.threads = t.max(1);
     }
-    let report = towpath_seq::solve(model.problem(), &opts).map_err(exit::bad_input)?;
+    let name = args.solver.solver;
+    let report = solve_with(name, model.problem(), &opts, &args.solver.params()).map_err(|e| match e {
+        BaselineError::BadParams(_)
+        | BaselineError::TooLarge { .. }
+        | BaselineError::Unsupported { .. }
+        | BaselineError::BadSets(_) => exit::bad_input(e),
+        // the instance is validated: any other failure is the solver's
+        e => anyhow::Error::new(e).context(format!("solver {name} failed")),
+    })?;
     let route = model.route(&report.solution.steps).map_err(exit::check_failed)?;
     let length = verify_route(model.instance(), &route).map_err(exit::check_failed)?;
-    let out = RouteJson::new(model.instance(), &route, "towpath", report.elapsed.as_secs_f64());
+    let out = RouteJson::new(model.instance(), &route, name.as_str(), report.elapsed.as_secs_f64());
     if let Some(path) = &args.output {
         let text = serde_json::to_string_pretty(&out)?;
         std::fs::write(path, text + "\n").with_context(|| format!("writing {}", path.display()))?;
@@ -87,7 +100,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             i.edges().len(),
             i.required().len()
         );
-        println!("  solver             : towpath");
+        println!("  solver             : {name} — {}", name.reference());
         println!("  path length        : {length:>12.3}");
         println!("  required edges     : {:>12.3}", out.required_length);
         println!("  connecting travel  : {:>12.3}", out.deadhead_length);
