@@ -33,6 +33,7 @@ mod castelino;
 mod common;
 mod doherty;
 mod ga;
+mod generate;
 mod order;
 mod registry;
 
@@ -42,4 +43,5 @@ pub use castelino::{
 };
 pub use doherty::{sets_from_precedence, solve_doherty, solve_doherty_traced, DohertyParams, PrecedenceSet, SetTrace};
 pub use ga::{bit_crossover, order_crossover, solve_ga, GaParams};
+pub use generate::random_gtsp;
 pub use registry::{solve_with, BaselineError, BaselineParams, SolverName};

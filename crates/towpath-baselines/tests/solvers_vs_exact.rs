@@ -259,3 +259,28 @@ fn time_limit_is_honoured() {
         check(model.problem(), &r.solution.steps).unwrap();
     }
 }
+
+#[test]
+fn castelino_on_built_gtsp_and_pcgtsp_instances() {
+    // GTSP-LIB-shaped instances small enough for the exact DP (25 points, 5–6 clusters: a
+    // transformed problem of 50 nodes).
+    let mut optimal = 0;
+    let mut total = 0;
+    for seed in 0..6u64 {
+        for precedence in [false, true] {
+            let p = random_gtsp(25, seed, precedence).unwrap();
+            let exact = solve_exact(&p).unwrap().unwrap().cost;
+            let opts =
+                SolveOptions { time_limit: None, iterations: Some(300), seed, threads: 1, ..SolveOptions::default() };
+            let r = solve_castelino(&p, &CastelinoParams::default(), &opts).unwrap();
+            let c = check(&p, &r.solution.steps).unwrap();
+            assert_eq!(c, r.solution.cost);
+            assert!(c >= exact - 1e-9, "seed {seed}: {c} below the optimum {exact}");
+            total += 1;
+            if c <= exact + 1e-9 {
+                optimal += 1;
+            }
+        }
+    }
+    assert!(optimal * 10 >= total * 8, "castelino optimal on {optimal} of {total}");
+}

@@ -21,6 +21,8 @@ enum Command {
     Demo(cmd::demo::Args),
     /// Integrate separate tool paths into one open route over a travel graph (seed 004's open rural postman).
     Route(cmd::route::Args),
+    /// Run a benchmark and print (or write into BENCHMARKS.md) its tables.
+    Bench(cmd::bench::Args),
 }
 
 fn main() {
@@ -28,6 +30,7 @@ fn main() {
     let result = match cli.command {
         Command::Demo(args) => cmd::demo::run(args),
         Command::Route(args) => cmd::route::run(args),
+        Command::Bench(args) => cmd::bench::run(args),
     };
     std::process::exit(exit::report(result));
 }
