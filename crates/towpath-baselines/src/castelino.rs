@@ -571,6 +571,33 @@ mod tests {
         }
     }
 
+    /// Any feasible route of the transformed problem (here: random orders that keep its
+    /// precedence, however many times they pay M) maps back to a feasible GTSP route.
+    #[test]
+    fn any_feasible_transformed_route_maps_back_to_a_feasible_route() {
+        use rand::{Rng, SeedableRng};
+        for seed in 0..30u64 {
+            let p = crate::random_gtsp(30, seed, seed % 2 == 0).unwrap();
+            let t = transform(&p, &CastelinoParams::default()).unwrap();
+            let pin = if p.is_cyclic() && p.first_task().is_some() { Some((TaskId(0), 0)) } else { None };
+            let tp = transformed_problem(&t, pin).unwrap();
+            let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
+            for _ in 0..20 {
+                let mut b = crate::order::OrderBuilder::new(&tp);
+                let mut steps = Vec::new();
+                while steps.len() < tp.num_tasks() {
+                    let allowed: Vec<u32> = (0..tp.num_tasks() as u32).filter(|&v| b.allowed(v)).collect();
+                    let v = allowed[rng.gen_range(0..allowed.len())];
+                    b.take(v);
+                    steps.push(Step { task: TaskId(v), mode: 0 });
+                }
+                towpath_seq::check(&tp, &steps).unwrap();
+                let back = map_back(&t, &steps);
+                towpath_seq::check(&p, &back).unwrap();
+            }
+        }
+    }
+
     #[test]
     fn removed_arcs_are_forbidden() {
         let p = small();

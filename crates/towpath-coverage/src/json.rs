@@ -297,6 +297,20 @@ mod tests {
         assert_eq!(back, i);
     }
 
+    /// Regression (found by fuzzing): numbers given with more digits than an f64 holds must
+    /// parse to the nearest f64, so that writing and reading again gives the same instance.
+    #[test]
+    fn long_numbers_round_trip() {
+        for len in ["1.0072030579778834", "1.0072030579778834999", "0.10000000000000000555"] {
+            let text = format!(
+                r#"{{"vertices": [[0, 0]], "edges": [{{"a": 0, "b": 0, "length": {len}, "required": true}}]}}"#
+            );
+            let i = read_instance(&text).unwrap();
+            assert_eq!(i.edges()[0].length, len.parse::<f64>().unwrap(), "{len}");
+            assert_eq!(read_instance(&write_instance(&i)).unwrap(), i, "{len}");
+        }
+    }
+
     #[test]
     fn errors_name_line_and_column() {
         let bad = GOOD.replace("\"b\": 2,", "\"b\": 9,");

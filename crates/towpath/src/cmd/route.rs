@@ -2,11 +2,13 @@
 //! edges (JSON), orders and orients the required edges so that the connecting travel along
 //! shortest paths is least, and writes the full vertex walk.
 
+use std::io::IsTerminal;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::Context;
-use towpath_baselines::{solve_with, BaselineError};
+use towpath_baselines::{solve_with, BaselineError, SolverName};
 use towpath_coverage::{read_instance, seed004_like, verify_route, write_instance, Instance, RouteJson, RppModel};
 use towpath_seq::SolveOptions;
 
@@ -74,6 +76,23 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         opts.threads = t.max(1);
     }
     let name = args.solver.solver;
+    // A progress bar on stderr for the time-limited searches, only on a terminal.
+    let bar =
+        (std::io::stderr().is_terminal() && matches!(name, SolverName::Towpath | SolverName::Castelino)).then(|| {
+            let bar = indicatif::ProgressBar::new(1000);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template("{spinner} {wide_bar} {elapsed_precise} {msg}")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            bar
+        });
+    if let Some(bar) = &bar {
+        let bar = bar.clone();
+        opts.progress = Some(Arc::new(move |p: &towpath_seq::Progress| {
+            bar.set_position((p.fraction * 1000.0) as u64);
+            bar.set_message(format!("best {:.3}", p.best_cost));
+        }));
+    }
     let report = solve_with(name, model.problem(), &opts, &args.solver.params()).map_err(|e| match e {
         BaselineError::BadParams(_)
         | BaselineError::TooLarge { .. }
@@ -82,6 +101,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         // the instance is validated: any other failure is the solver's
         e => anyhow::Error::new(e).context(format!("solver {name} failed")),
     })?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
     let route = model.route(&report.solution.steps).map_err(exit::check_failed)?;
     let length = verify_route(model.instance(), &route).map_err(exit::check_failed)?;
     let out = RouteJson::new(model.instance(), &route, name.as_str(), report.elapsed.as_secs_f64());
