@@ -28,6 +28,10 @@ enum Command {
     Optimize(cmd::optimize::Args),
     /// Check an optimized AFP program against its original and print the savings.
     Verify(cmd::verify::Args),
+    /// Integrate separate tool paths into one open route over a travel graph (seed 004's open rural postman).
+    Route(cmd::route::Args),
+    /// Run a benchmark and print (or write into BENCHMARKS.md) its tables.
+    Bench(cmd::bench::Args),
 }
 
 fn main() {
@@ -38,6 +42,8 @@ fn main() {
         Command::Layup(args) => cmd::layup::run(*args),
         Command::Optimize(args) => cmd::optimize::run(args),
         Command::Verify(args) => cmd::verify::run(args),
+        Command::Route(args) => cmd::route::run(args),
+        Command::Bench(args) => cmd::bench::run(args),
     };
     std::process::exit(exit::report(result));
 }
