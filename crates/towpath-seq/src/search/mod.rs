@@ -59,7 +59,7 @@ pub struct SolveOptions {
     /// Set to true to stop the search early; the best route so far is returned.
     pub cancel: Option<Arc<AtomicBool>>,
     /// Problems with at most this many tasks (and at most 6 modes per task) are solved exactly
-    /// by dynamic programming instead (default 9).
+    /// by dynamic programming instead (default 10).
     pub exact_up_to: usize,
 }
 
@@ -73,7 +73,7 @@ impl Default for SolveOptions {
             initial: None,
             progress: None,
             cancel: None,
-            exact_up_to: 9,
+            exact_up_to: 10,
         }
     }
 }
@@ -159,20 +159,21 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         } else {
             construct::seed_pool(&net, pool_size)
         };
+        // Stop early at the deadline, but always end with at least one start.
+        let have_initial = opts.initial.is_some();
         for f in pool {
-            let (seq, mode) = construct::nearest_neighbor(&net, Some(f));
-            if seq.len() == net.n {
-                starts.push(Tour::new(&net, seq, mode));
+            let limit = if starts.is_empty() && !have_initial { None } else { deadline };
+            match construct::nearest_neighbor(&net, Some(f), limit) {
+                Some((seq, mode)) if seq.len() == net.n => starts.push(Tour::new(&net, seq, mode)),
+                Some(_) => {}
+                None => break,
             }
         }
     }
     if let Some(steps) = &opts.initial {
         starts.push(tour_from_steps(&net, steps));
     }
-    let eps = {
-        let c = starts.iter().map(|t| t.cost).filter(|c| c.is_finite()).fold(0.0, f64::max);
-        1e-9 * (c / n.max(1) as f64).max(1.0)
-    };
+    let eps = 1e-9 * net.typical_arc;
     let k = if n > 20_000 { 8 } else { 10 };
     let nb = Neighbors::build(&net, k);
     let ils = Ils::new(&net, &nb, eps);
