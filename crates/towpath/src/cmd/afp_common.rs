@@ -15,7 +15,7 @@ pub struct MachineArgs {
     #[arg(long, value_name = "MACHINE.toml")]
     pub machine: PathBuf,
     /// Program dialect (TOML); without it the reference dialect (ISO G-code, M20/M21 contact,
-    /// M60/M61 P<mask> tows, (PLY n) and (COURSE n) comments). See docs/dialect.md.
+    /// `M60`/`M61 P<mask>` tows, (PLY n) and (COURSE n) comments). See docs/dialect.md.
     #[arg(long, value_name = "DIALECT.toml")]
     pub dialect: Option<PathBuf>,
     /// Tow width in mm: course width = tow width × tows on (read from the restart/cut masks).
