@@ -395,7 +395,13 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             0.0
         };
         let best = if net.has_prec && tour.len() <= SCAN_UP_TO {
-            self.scan_insertions(tour, i, j, gain, rev_ok, rev_inside)
+            // near positions exhaustively, far ones through the candidate lists
+            let near = self.scan_insertions(tour, i, j, gain, rev_ok, rev_inside);
+            let far = self.candidate_insertions(tour, i, j, gain, rev_ok, rev_inside);
+            match (near, far) {
+                (Some(a), Some(b)) => Some(if b.delta < a.delta { b } else { a }),
+                (a, b) => a.or(b),
+            }
         } else {
             self.candidate_insertions(tour, i, j, gain, rev_ok, rev_inside)
         };
