@@ -1,5 +1,6 @@
 //! Errors of the AFP program layer.
 
+use towpath_baselines::BaselineError;
 use towpath_machine::{CostError, MachineError};
 use towpath_seq::{ModelError, SolveError};
 
@@ -29,6 +30,10 @@ pub enum NcError {
     /// The sequencing engine refused the problem.
     #[error("sequencing: {0}")]
     Sequencing(String),
+    /// The chosen solver cannot sequence this program (one of the seed papers' solvers: the
+    /// message names it and what it cannot handle).
+    #[error("{0}")]
+    Solver(String),
     /// The optimizer's own output did not verify (a bug: the input is left untouched).
     #[error("the optimized program did not verify: {0}")]
     SelfCheck(String),
@@ -55,6 +60,15 @@ impl From<CostError> for NcError {
 impl From<ModelError> for NcError {
     fn from(e: ModelError) -> Self {
         NcError::Sequencing(e.to_string())
+    }
+}
+
+impl From<BaselineError> for NcError {
+    fn from(e: BaselineError) -> Self {
+        match e {
+            BaselineError::Solve(e) => NcError::Sequencing(e.to_string()),
+            e => NcError::Solver(e.to_string()),
+        }
     }
 }
 

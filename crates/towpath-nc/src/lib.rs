@@ -22,6 +22,7 @@ mod program;
 mod report;
 mod reverse;
 mod rewrite;
+mod sequencer;
 mod verify;
 
 pub use dialect::{Code, Dialect, EventTiming};
@@ -37,4 +38,6 @@ pub use program::{ply_name, Course, Item, Ply, Program, Region, Segment};
 pub use report::{totals, GroupCost, GroupRow, OrderRow, Report, Totals};
 pub use reverse::{reversal_of, reverse_course, Reversed};
 pub use rewrite::{rewrite, Placement};
+pub use sequencer::{seed000_sets, sequence};
+pub use towpath_baselines::{BaselineParams, SolverName};
 pub use verify::{measure, verify, verify_parsed, Motion, Verification, VerifyError, VerifyOptions};

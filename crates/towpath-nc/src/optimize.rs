@@ -3,14 +3,16 @@
 use std::time::{Duration, Instant};
 
 use serde::Serialize;
+use towpath_baselines::{BaselineParams, SolverName};
 use towpath_machine::Machine;
-use towpath_seq::{check, solve, SolveOptions, Step};
+use towpath_seq::{check, SolveOptions, Step};
 
 use crate::dialect::Dialect;
 use crate::error::NcError;
 use crate::problem::{build_problem, placements, AfpOptions, AfpProblem};
 use crate::program::Program;
 use crate::rewrite::{rewrite, Placement};
+use crate::sequencer::sequence;
 use crate::verify::{verify_parsed, Verification, VerifyOptions};
 
 /// How to optimize.
@@ -28,6 +30,11 @@ pub struct OptimizeOptions {
     pub threads: usize,
     /// Called as the solver progresses.
     pub progress: Option<towpath_seq::ProgressFn>,
+    /// The solver: towpath's own (default) or one of the seed papers' (for comparison).
+    pub solver: SolverName,
+    /// Parameters of the seed papers' solvers. `doherty` without `sets` gets the program's
+    /// seed-000 precedence sets ([`crate::seed000_sets`]).
+    pub baselines: BaselineParams,
 }
 
 impl Default for OptimizeOptions {
@@ -39,6 +46,8 @@ impl Default for OptimizeOptions {
             seed: 1,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
             progress: None,
+            solver: SolverName::Towpath,
+            baselines: BaselineParams::default(),
         }
     }
 }
@@ -57,6 +66,8 @@ impl std::fmt::Debug for OptimizeOptions {
             .field("iterations", &self.iterations)
             .field("seed", &self.seed)
             .field("threads", &self.threads)
+            .field("solver", &self.solver)
+            .field("baselines", &self.baselines)
             .finish()
     }
 }
@@ -81,6 +92,8 @@ pub struct Timings {
 /// The solver's side of the story.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct SolverSummary {
+    /// The solver that ran (`towpath`, `doherty`, `castelino`, `ga`, `aco1`, `aco2`).
+    pub solver: String,
     /// Route cost of the original order (the solver's objective).
     pub initial_cost: f64,
     /// Route cost of the answer.
@@ -114,7 +127,8 @@ pub struct Optimized {
 }
 
 /// Optimizes a program: returns the rewritten text, verified against the input, never costing
-/// more off-part motion (under the chosen cost model) than the input.
+/// more off-part motion (under the chosen cost model) than the input. The courses are
+/// sequenced by `opts.solver` (towpath's own by default).
 pub fn optimize(
     text: &str,
     machine: &Machine,
@@ -128,8 +142,12 @@ pub fn optimize(
     let afp = build_problem(&program, machine, dialect, &opts.afp)?;
     let t_build = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
-    let report = solve(
-        &afp.problem,
+    let report = sequence(
+        opts.solver,
+        &opts.baselines,
+        &program,
+        &afp,
+        &opts.afp,
         &SolveOptions {
             time_limit: opts.time_limit,
             iterations: opts.iterations,
@@ -142,6 +160,7 @@ pub fn optimize(
     )?;
     let t_solve = t2.elapsed().as_secs_f64();
     let solver = SolverSummary {
+        solver: opts.solver.to_string(),
         initial_cost: report.initial_cost.unwrap_or(f64::NAN),
         cost: report.solution.cost,
         iterations: report.iterations,

@@ -280,9 +280,10 @@ impl Report {
         }
         let _ = writeln!(
             s,
-            "  {} courses reversed; verified; {:.2} s (solve {:.2} s){}",
+            "  {} courses reversed; verified; {:.2} s (solver {}: {:.2} s){}",
             self.reversed,
             self.timings.total,
+            self.solver.solver,
             self.timings.solve,
             if self.fell_back { "; no cheaper order found: the input is returned unchanged" } else { "" }
         );

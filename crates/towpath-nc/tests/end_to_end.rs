@@ -47,3 +47,68 @@ fn demo_parts_optimize_and_verify() {
         }
     }
 }
+
+/// Seed 000's solver through `optimize`: it runs per seed-000 precedence set (every course of a
+/// set is laid before any course of the next), its answer is written and verified like
+/// towpath's, saves off-part motion on the badly planned parts, and never costs more.
+#[test]
+fn doherty_sequences_the_demo_parts_set_by_set() {
+    use towpath_nc::{seed000_sets, PrecedenceRule, SolverName};
+    let d = Dialect::default();
+    for part in demo_parts() {
+        for precedence in [PrecedenceRule::Courses, PrecedenceRule::Sets, PrecedenceRule::Plies] {
+            let afp = AfpOptions {
+                cost: CostKind::Axis,
+                bidirectional: true,
+                precedence,
+                width: Some(Width::Tow(TOW_WIDTH)),
+                ..AfpOptions::default()
+            };
+            let opts = OptimizeOptions {
+                afp: afp.clone(),
+                time_limit: Some(Duration::from_secs(10)),
+                threads: 1,
+                solver: SolverName::Doherty,
+                ..OptimizeOptions::default()
+            };
+            let o = optimize(&part.program, &part.machine, &d, &opts).unwrap();
+            assert_eq!(o.solver.solver, "doherty");
+            let (b, a) = o.verification.motion(CostKind::Axis).unwrap();
+            assert!(a.off_part() <= b.off_part() + 1e-6, "{} {precedence}", part.name);
+            assert!(
+                a.off_part() < 0.9 * b.off_part(),
+                "{} {precedence}: {} -> {}",
+                part.name,
+                b.off_part(),
+                a.off_part()
+            );
+            // Set by set, in order.
+            let sets = seed000_sets(&o.program, &o.afp, &afp).unwrap();
+            let mut set_of = vec![usize::MAX; o.program.courses.len()];
+            for (k, s) in sets.iter().enumerate() {
+                for t in &s.tasks {
+                    set_of[t.index()] = k;
+                }
+            }
+            assert!(set_of.iter().all(|&k| k != usize::MAX), "{}: the sets cover every course", part.name);
+            let laid: Vec<usize> = o.order.iter().map(|p| set_of[p.course]).collect();
+            assert!(laid.windows(2).all(|w| w[0] <= w[1]), "{} {precedence}: sets out of order {laid:?}", part.name);
+        }
+    }
+}
+
+#[test]
+fn doherty_refuses_to_keep_the_ply_order() {
+    use towpath_nc::{NcError, SolverName};
+    let d = Dialect::default();
+    let part = &demo_parts()[0];
+    let opts = OptimizeOptions {
+        afp: AfpOptions { keep_ply_order: true, width: Some(Width::Tow(TOW_WIDTH)), ..AfpOptions::default() },
+        solver: SolverName::Doherty,
+        ..OptimizeOptions::default()
+    };
+    match optimize(&part.program, &part.machine, &d, &opts) {
+        Err(NcError::Solver(m)) => assert!(m.contains("keep-ply-order"), "{m}"),
+        other => panic!("expected a solver error, got {:?}", other.map(|o| o.solver)),
+    }
+}

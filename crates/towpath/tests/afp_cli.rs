@@ -137,3 +137,50 @@ fn bad_input_names_file_and_line() {
     assert!(err.contains("m.toml") && err.contains("line 4"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `towpath optimize --solver NAME`: the seed papers' solvers sequence the same program, their
+/// answers are written and verified like towpath's, and the report says which solver ran.
+#[test]
+fn optimize_with_each_solver() {
+    let d = temp_dir("solvers");
+    demo(&d);
+    let optimize = |solver: &str, extra: &[&str]| {
+        run(towpath()
+            .arg("optimize")
+            .arg(d.join("planar-0.nc"))
+            .arg("--machine")
+            .arg(d.join("gantry-afp.toml"))
+            .arg("--dialect")
+            .arg(d.join("dialect.toml"))
+            .args(["--bidirectional", "--time-limit", "0.3", "--threads", "1", "--json", "--solver", solver])
+            .args(extra)
+            .arg("-o")
+            .arg(d.join(format!("{solver}.nc"))))
+    };
+    for solver in ["doherty", "ga", "aco1", "aco2", "castelino", "towpath"] {
+        let (code, stdout, err) = optimize(solver, &[]);
+        assert_eq!(code, 0, "{solver}: {err}");
+        let json: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+        assert_eq!(json["solver"]["solver"], solver);
+        assert_eq!(json["verified"], true);
+        let axis = json["totals"].as_array().unwrap().iter().find(|t| t["kind"] == "axis").unwrap();
+        let (before, after) = (axis["off_before"].as_f64().unwrap(), axis["off_after"].as_f64().unwrap());
+        assert!(after <= before, "{solver}: {before} -> {after}");
+        // The written program verifies on its own.
+        let (code, stdout, err) = run(towpath()
+            .arg("verify")
+            .arg(d.join("planar-0.nc"))
+            .arg(d.join(format!("{solver}.nc")))
+            .arg("--machine")
+            .arg(d.join("gantry-afp.toml"))
+            .arg("--dialect")
+            .arg(d.join("dialect.toml")));
+        assert_eq!(code, 0, "{solver}: {err}");
+        assert!(stdout.starts_with("verified: 30 courses"), "{solver}: {stdout}");
+    }
+    // Seed 000's solver lays each precedence set freely: it cannot keep the ply order.
+    let (code, _, err) = optimize("doherty", &["--keep-ply-order"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("planar-0.nc") && err.contains("doherty") && err.contains("--keep-ply-order"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -87,3 +87,83 @@ fn malformed_file_exits_2_with_file_and_line() {
     assert_eq!(out.status.code(), Some(2));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The cost of a closed tour over br17's full matrix, read from the file here (independent of
+/// the readers and the checker).
+fn br17_tour_cost(tour: &[u64]) -> f64 {
+    let text = std::fs::read_to_string(fixture("br17.atsp")).unwrap();
+    let body = text.split("EDGE_WEIGHT_SECTION").nth(1).unwrap();
+    let m: Vec<f64> = body.split_whitespace().filter_map(|w| w.parse().ok()).collect();
+    assert!(m.len() >= 17 * 17);
+    (0..tour.len()).map(|i| m[(tour[i] as usize - 1) * 17 + tour[(i + 1) % tour.len()] as usize - 1]).sum()
+}
+
+#[test]
+fn every_solver_answers_and_says_which_ran() {
+    for solver in ["towpath", "doherty", "castelino", "ga", "aco1", "aco2", "aco"] {
+        let name = if solver == "aco" { "aco2" } else { solver };
+        let v = solve_json("br17.atsp", &["--time-limit", "0.3", "--solver", solver]);
+        assert_eq!(v["solver"], name);
+        let tour: Vec<u64> = v["tour"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect();
+        let mut sorted = tour.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (1..=17).collect::<Vec<_>>(), "{solver}");
+        let cost = v["cost"].as_f64().unwrap();
+        assert_eq!(cost, br17_tour_cost(&tour), "{solver}: reported cost is the tour's");
+        assert!(cost >= 39.0, "{solver}: {cost} below br17's optimum");
+
+        let v = solve_json("ESC07.sop", &["--time-limit", "0.3", "--solver", solver]);
+        assert_eq!(v["solver"], name);
+        let tour: Vec<u64> = v["tour"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect();
+        assert_eq!((tour.first(), tour.last(), tour.len()), (Some(&1), Some(&9), 9), "{solver}");
+        assert!(v["cost"].as_f64().unwrap() >= 2125.0, "{solver}");
+    }
+}
+
+#[test]
+fn randomized_solvers_repeat_under_a_seed() {
+    for solver in ["ga", "aco1", "aco2"] {
+        let path = fixture("11berlin52.gtsp");
+        let run = |seed: &str| {
+            let out = towpath(&["solve", path.to_str().unwrap(), "--json", "--solver", solver, "--seed", seed]);
+            assert!(out.status.success(), "{solver}: {}", String::from_utf8_lossy(&out.stderr));
+            let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            (v["tour"].clone(), v["cost"].as_f64().unwrap())
+        };
+        let a = run("5");
+        assert_eq!(a, run("5"), "{solver}: same seed, same answer");
+        assert!(a.1 >= 4040.0, "{solver}: {} below 11berlin52's optimum", a.1);
+    }
+}
+
+#[test]
+fn a_solver_that_cannot_take_the_problem_exits_2() {
+    // Seed 000's solver has no consecutive groups; example.json has one.
+    let path = fixture("example.json");
+    let out = towpath(&["solve", path.to_str().unwrap(), "--solver", "doherty", "--json"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("example.json") && stderr.contains("doherty") && stderr.contains("consecutive"),
+        "{stderr}"
+    );
+    assert!(out.stdout.is_empty());
+    // The ant system keeps dense trails: more than 2048 points are refused, not a crash.
+    let dir = std::env::temp_dir().join(format!("towpath-solve-aco-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let big = dir.join("grid2500.tsp");
+    let mut text =
+        String::from("NAME: grid2500\nTYPE: TSP\nDIMENSION: 2500\nEDGE_WEIGHT_TYPE: EUC_2D\nNODE_COORD_SECTION\n");
+    for i in 0..2500 {
+        text.push_str(&format!("{} {} {}\n", i + 1, i % 50, i / 50));
+    }
+    text.push_str("EOF\n");
+    std::fs::write(&big, text).unwrap();
+    let out = towpath(&["solve", big.to_str().unwrap(), "--solver", "aco1"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("grid2500.tsp") && stderr.contains("aco1") && stderr.contains("too large"), "{stderr}");
+    let out = towpath(&["solve", big.to_str().unwrap(), "--solver", "lkh"]);
+    assert_eq!(out.status.code(), Some(2));
+    std::fs::remove_dir_all(&dir).ok();
+}

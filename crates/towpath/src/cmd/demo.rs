@@ -8,12 +8,13 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use anyhow::Context;
 use towpath_machine::CostKind;
 use towpath_nc::demo::{demo_parts, gantry, mandrel_machine, TOW_WIDTH};
 use towpath_nc::{optimize, parse, verify, AfpOptions, Dialect, OptimizeOptions, Report, VerifyOptions};
 
 use super::afp_common::write;
+use super::optimize::classify;
+use super::solver_args::SolverArgs;
 use crate::exit;
 
 /// Arguments of `towpath demo`.
@@ -34,6 +35,8 @@ pub struct Args {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub solver: SolverArgs,
 }
 
 /// Runs the demo.
@@ -50,14 +53,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let opts = OptimizeOptions {
         afp: afp.clone(),
         time_limit: Some(Duration::from_secs_f64(args.time_limit)),
+        solver: args.solver.solver,
+        baselines: args.solver.params(),
         ..OptimizeOptions::default()
     };
     if !args.json {
         println!("towpath demo: seed 000's AFP test parts, written to {}/", dir.display());
         println!(
             "Each program is planned badly on purpose: plies out of order, every course laid in the same direction.\n\
-             towpath re-sequences the courses ({}, a course after the courses of earlier plies it overlaps),\n\
-             rewrites only the off-part motion, and verifies the result independently.\n",
+             The {} solver re-sequences the courses ({}, a course after the courses of earlier plies it overlaps),\n\
+             towpath rewrites only the off-part motion and verifies the result independently.\n",
+            args.solver.solver,
             if args.unidirectional { "unidirectional" } else { "bidirectional" }
         );
         println!(
@@ -76,8 +82,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let prog_path = dir.join(format!("{}.nc", part.name));
         let out_path = dir.join(format!("{}.opt.nc", part.name));
         write(&prog_path, &part.program)?;
-        let o = optimize(&part.program, &part.machine, &dialect, &opts)
-            .with_context(|| format!("optimizing the demo part {}", part.name))?;
+        let o = optimize(&part.program, &part.machine, &dialect, &opts).map_err(|e| classify(&prog_path, e))?;
         write(&out_path, &o.text)?;
         let report = Report::new(&format!("{}.nc", part.name), &part.machine, &o, &afp);
         let optimized = parse(&o.text, &part.machine, &dialect)?;
@@ -112,6 +117,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "seed_000_total_saved_percent": if seed_total.is_nan() { None } else { Some(seed_total) },
             "program": prog_path,
             "optimized": out_path,
+            "solver": o.solver.solver,
             "seconds": o.timings.total,
         }));
     }

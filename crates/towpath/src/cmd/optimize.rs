@@ -7,6 +7,7 @@ use towpath_machine::CostKind;
 use towpath_nc::{optimize, AfpOptions, NcError, OptimizeOptions, PrecedenceRule, Report};
 
 use super::afp_common::{read, write, MachineArgs};
+use super::solver_args::SolverArgs;
 use crate::exit;
 
 /// Arguments of `towpath optimize`.
@@ -49,12 +50,16 @@ pub struct Args {
     /// Print the report as one JSON object on stdout instead of a summary.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub solver: SolverArgs,
 }
 
 /// Maps an optimization error to an exit code, naming the program file.
 pub fn classify(file: &std::path::Path, e: NcError) -> anyhow::Error {
     match e {
         NcError::SelfCheck(_) => exit::check_failed(anyhow::anyhow!("{}: {e}", file.display())),
+        // Everything else, a solver that cannot take this program (`NcError::Solver`) included,
+        // refuses the input.
         _ => exit::bad_input(anyhow::anyhow!("{}: {e}", file.display())),
     }
 }
@@ -96,6 +101,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             });
             f
         }),
+        solver: args.solver.solver,
+        baselines: args.solver.params(),
         ..OptimizeOptions::default()
     };
     let o = optimize(&text, &machine, &dialect, &opts).map_err(|e| classify(&args.program, e));

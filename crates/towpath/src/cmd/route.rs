@@ -8,11 +8,11 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::Context;
-use towpath_baselines::{solve_with, BaselineError, SolverName};
+use towpath_baselines::{solve_with, SolverName};
 use towpath_coverage::{read_instance, seed004_like, verify_route, write_instance, Instance, RouteJson, RppModel};
 use towpath_seq::SolveOptions;
 
-use crate::cmd::solver_args::SolverArgs;
+use crate::cmd::solver_args::{refused, SolverArgs};
 use crate::exit;
 
 /// Arguments of `towpath route`.
@@ -93,14 +93,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             bar.set_message(format!("best {:.3}", p.best_cost));
         }));
     }
-    let report = solve_with(name, model.problem(), &opts, &args.solver.params()).map_err(|e| match e {
-        BaselineError::BadParams(_)
-        | BaselineError::TooLarge { .. }
-        | BaselineError::Unsupported { .. }
-        | BaselineError::BadSets(_) => exit::bad_input(e),
-        // the instance is validated: any other failure is the solver's
-        e => anyhow::Error::new(e).context(format!("solver {name} failed")),
-    })?;
+    let report = solve_with(name, model.problem(), &opts, &args.solver.params()).map_err(|e| refused(name, e))?;
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }

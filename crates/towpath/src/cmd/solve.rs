@@ -7,9 +7,11 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::anyhow;
+use towpath_baselines::{solve_with, SolverName};
 use towpath_formats::{read_instance, with_problem, Instance};
 use towpath_seq::{Progress, SolveOptions, SolveReport};
 
+use crate::cmd::solver_args::{refusal, SolverArgs};
 use crate::exit;
 
 /// Arguments of `towpath solve`.
@@ -43,6 +45,8 @@ pub struct Args {
     /// Print one JSON object on stdout instead of a summary.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub solver: SolverArgs,
 }
 
 /// The default time limit when neither a time limit nor a work budget is given.
@@ -63,7 +67,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let threads = args.threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1);
     let instance = read_instance(&args.file).map_err(exit::bad_input)?;
 
-    let bar = progress_bar(time_limit.is_some() || args.iterations.is_some());
+    // Only towpath's search (alone or inside castelino) reports progress.
+    let reports_progress = matches!(args.solver.solver, SolverName::Towpath | SolverName::Castelino);
+    let bar = progress_bar(reports_progress && (time_limit.is_some() || args.iterations.is_some()));
     let progress = bar.clone().map(|bar| {
         Arc::new(move |p: &Progress| {
             bar.set_position((p.fraction * 1000.0) as u64);
@@ -78,8 +84,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         progress,
         ..SolveOptions::default()
     };
-    let report: SolveReport = with_problem!(&instance.problem, p => towpath_seq::solve(p, &options))
-        .map_err(|e| exit::bad_input(anyhow!("{}: {e}", args.file.display())))?;
+    let name = args.solver.solver;
+    let params = args.solver.params();
+    let report: SolveReport = with_problem!(&instance.problem, p => solve_with(name, p, &options, &params))
+        .map_err(|e| exit::bad_input(anyhow!("{}: {}", args.file.display(), refusal(name, &e))))?;
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
@@ -122,6 +130,7 @@ fn print_answer(
                 "file": args.file.display().to_string(),
                 "name": instance.name,
                 "type": instance.kind.as_str(),
+                "solver": args.solver.solver.as_str(),
                 "dimension": instance.dimension,
                 "tasks": instance.num_tasks(),
                 "cost": cost,
@@ -137,7 +146,7 @@ fn print_answer(
     }
     writeln!(
         out,
-        "{} ({}, dimension {}, {} tasks): cost {} in {:.2} s, {} iterations{} (seed {}, {} threads); checked",
+        "{} ({}, dimension {}, {} tasks): cost {} in {:.2} s, {} iterations{} (solver {}, seed {}, {} threads); checked",
         instance.name,
         instance.kind,
         instance.dimension,
@@ -146,6 +155,7 @@ fn print_answer(
         report.elapsed.as_secs_f64(),
         report.iterations,
         if report.exact { ", proven optimal" } else { "" },
+        args.solver.solver,
         args.seed,
         threads
     )?;

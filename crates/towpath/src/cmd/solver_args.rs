@@ -1,7 +1,9 @@
 //! `--solver NAME` and the baselines' parameters, shared by every command that sequences
 //! (flatten [`SolverArgs`] into a command's `Args`).
 
-use towpath_baselines::{AcoParams, BaselineParams, DohertyParams, GaParams, SolverName};
+use towpath_baselines::{AcoParams, BaselineError, BaselineParams, DohertyParams, GaParams, SolverName};
+
+use crate::exit;
 
 /// Which solver sequences the tasks, and the parameters of the seed papers' solvers.
 #[derive(clap::Args, Debug, Clone)]
@@ -42,4 +44,18 @@ impl SolverArgs {
             ..BaselineParams::default()
         }
     }
+}
+
+/// Why a solver could not sequence a valid input, naming the solver once; for the seed papers'
+/// solvers the message points to towpath's, which takes every valid problem.
+pub fn refusal(name: SolverName, e: &BaselineError) -> String {
+    let text = e.to_string();
+    let text = if text.starts_with(name.as_str()) { text } else { format!("solver {name}: {text}") };
+    let hint = if name == SolverName::Towpath { "" } else { " (--solver towpath takes every valid problem)" };
+    format!("{text}{hint}")
+}
+
+/// [`refusal`] as refused input (exit code 2).
+pub fn refused(name: SolverName, e: BaselineError) -> anyhow::Error {
+    exit::bad_input(anyhow::anyhow!("{}", refusal(name, &e)))
 }
