@@ -4,11 +4,12 @@
 //! 1. seed 004's comparison (Table I): GA, ACO1 and ACO2 at the paper's settings and towpath's
 //!    solver at a short time limit, on generated instances of the ten Table I sizes;
 //! 2. seed 000's solver against towpath's on AFP-like parts built like the paper's planar test
-//!    cases (Figs. 7–10): off-part travel saved from the original order;
-//! 3. seed 003's transformation (castelino) against towpath's direct search on GTSP and PCGTSP
-//!    instances built in code (GTSP-LIB / PCGLNS files once the formats crate reads them).
+//!    cases (Figs. 7–10) and on `towpath demo`'s AFP programs: off-part travel saved from the
+//!    original order;
+//! 3. seed 003's transformation (castelino) against towpath's direct search on GTSP-LIB and
+//!    PCGLNS files from the benchmark data (`--data`).
 //!
-//! Every solver runs on one thread. Times are wall times of the solve (shortest paths and
+//! Every solver runs on one thread, except on the GTSP files (`--gtsp-threads`, both alike). Times are wall times of the solve (shortest paths and
 //! model building excluded, they are shared), medians over instances and runs; they are noisy on
 //! a shared machine.
 
@@ -35,9 +36,15 @@ pub struct Args {
     /// A long towpath run per seed-004 instance as a reference (best known), milliseconds; 0 skips it.
     #[arg(long, default_value_t = 500.0)]
     pub reference_ms: f64,
-    /// Time limit of both castelino and towpath on each GTSP instance, seconds.
-    #[arg(long, default_value_t = 2.0)]
+    /// Time limit of both castelino and towpath on each GTSP-LIB / PCGLNS file, seconds.
+    #[arg(long, default_value_t = 5.0)]
     pub gtsp_seconds: f64,
+    /// Threads of both castelino and towpath on the GTSP-LIB / PCGLNS files.
+    #[arg(long, default_value_t = 2)]
+    pub gtsp_threads: usize,
+    /// The benchmark data directory (with `index.csv`, `gtsp/gtsplib/`, `pcgtsp/`).
+    #[arg(long, value_name = "DIR", default_value = "/work/shared/data")]
+    pub data: PathBuf,
     /// A small, fast run (3 sizes, 2 instances, 1 run) to check the benchmark works.
     #[arg(long)]
     pub quick: bool,
@@ -56,8 +63,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     md.push_str(HEADING);
     md.push_str("\n\n");
     md.push_str(&format!(
-        "Measured by `towpath bench baselines{}` ({}). Every solver on one thread; times are wall \
-         times of the solve, medians over instances and runs, noisy on a shared 2-core machine.\n\n",
+        "Measured by `towpath bench baselines{}` ({}). Every solver on one thread except where a table \
+         says otherwise; times are wall times of the solve, medians over instances and runs, noisy on a \
+         shared 2-core machine.\n\n",
         if args.quick { " --quick" } else { "" },
         machine()
     ));
