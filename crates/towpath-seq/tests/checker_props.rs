@@ -30,8 +30,10 @@ fn problem(n: usize, coords: &[(f64, f64)], modes: &[u8], edges: &[(usize, usize
     b.build().expect("edges go forward in task order, so they are acyclic")
 }
 
-fn arb_case() -> impl Strategy<Value = (usize, Vec<(f64, f64)>, Vec<u8>, Vec<(usize, usize)>, bool, Vec<usize>, Vec<u8>)>
-{
+/// (tasks, point coordinates, mode counts, precedence pairs, has start, order, mode picks)
+type Case = (usize, Vec<(f64, f64)>, Vec<u8>, Vec<(usize, usize)>, bool, Vec<usize>, Vec<u8>);
+
+fn arb_case() -> impl Strategy<Value = Case> {
     (2usize..9).prop_flat_map(|n| {
         (
             Just(n),
