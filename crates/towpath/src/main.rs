@@ -21,6 +21,8 @@ enum Command {
     Demo(cmd::demo::Args),
     /// Solve a TSPLIB (TSP, ATSP, SOP), GTSP-LIB, PCGLNS or towpath JSON problem file.
     Solve(cmd::solve::Args),
+    /// Write a problem file (TSPLIB, GTSP-LIB, PCGLNS, JSON) as towpath JSON, optionally with an explicit matrix.
+    Convert(cmd::convert::Args),
 }
 
 fn main() {
@@ -28,6 +30,7 @@ fn main() {
     let result = match cli.command {
         Command::Demo(args) => cmd::demo::run(args),
         Command::Solve(args) => cmd::solve::run(args),
+        Command::Convert(args) => cmd::convert::run(args),
     };
     std::process::exit(exit::report(result));
 }
