@@ -569,13 +569,16 @@ def main() -> None:
                     rec = {"instance": name, "path": rel, "kind": kind, "solver": solver, "run": run, "seed": seed,
                            "time_limit": args.time_limit, "threads": args.threads, "load1": os.getloadavg()[0]}
                     loads.append(rec["load1"])
-                    if solver == "towpath":
-                        rec.update(run_towpath(towpath, src, args.time_limit, seed, args.threads, model))
-                    elif kind not in PEER_KINDS.get(solver, set()):
-                        rec.update(cost=None, status="n/a")
-                    else:
-                        rec.update(run_peer(solver, kind, mat_json, nat_json, args.time_limit, seed, args.threads,
-                                            model))
+                    try:
+                        if solver == "towpath":
+                            rec.update(run_towpath(towpath, src, args.time_limit, seed, args.threads, model))
+                        elif kind not in PEER_KINDS.get(solver, set()):
+                            rec.update(cost=None, status="n/a")
+                        else:
+                            rec.update(run_peer(solver, kind, mat_json, nat_json, args.time_limit, seed,
+                                                args.threads, model))
+                    except Exception as e:  # noqa: BLE001 - one failure must not stop the benchmark
+                        rec.update(cost=None, status=f"harness error: {type(e).__name__}: {e}")
                     append_result(args.results, rec)
                     print(f"{name:>16} {solver:>9} run {run}: cost {rec.get('cost')} "
                           f"time {rec.get('time', 0):.1f}s {rec.get('status', '')} (load {rec['load1']:.1f})",
