@@ -228,9 +228,15 @@ def solve_lkh3(model: Model, native: dict, kind: str, limit: float, seed: int) -
     params = (f"RUNS = 1\nMAX_TRIALS = 1000000000\nTIME_LIMIT = {limit}\nTOTAL_TIME_LIMIT = {limit}\n"
               f"SEED = {seed}\nTRACE_LEVEL = 0\nPRECISION = 1\nPROBLEM_FILE = :stdin:\n")
     tour = [v - 1 for v in _elkai.solve_problem(params, problem)]
+    note = ""
+    if not tour:
+        # Its preprocessing alone used up TOTAL_TIME_LIMIT: give the limit to the search only.
+        params = params.replace(f"TOTAL_TIME_LIMIT = {limit}\n", "")
+        tour = [v - 1 for v in _elkai.solve_problem(params, problem)]
+        note = "† no tour within TOTAL_TIME_LIMIT; re-run with TIME_LIMIT only (preprocessing not limited)"
     if kind == "GTSP":
-        return seqlib.noon_bean_decode(tour, model.sets()), "Noon-Bean ATSP"
-    return tour, ""
+        return seqlib.noon_bean_decode(tour, model.sets()), note or "Noon-Bean ATSP"
+    return tour, note
 
 
 def solve_fast_tsp(model: Model, limit: float, threads: int) -> tuple[list[int], str]:
@@ -478,15 +484,13 @@ def append_result(path: Path, rec: dict) -> None:
 
 
 def versions() -> dict[str, str]:
-    out = {}
-    try:
-        from importlib.metadata import version
-
-        for k in PINS:
-            out[k] = version(k)
-    except Exception:  # noqa: BLE001 - versions are informative only
-        pass
-    return out
+    """Installed versions of the peers (asked of bench/.venv when not running inside it)."""
+    code = "from importlib.metadata import version as v; print(' '.join(v(k) for k in %r))" % list(PINS)
+    python = sys.executable if in_venv() or not venv_python().exists() else str(venv_python())
+    out = subprocess.run([python, "-c", code], capture_output=True, text=True)
+    if out.returncode != 0:
+        return {}
+    return dict(zip(PINS, out.stdout.split()))
 
 
 def machine() -> str:
@@ -652,6 +656,13 @@ def write_report(args, index, instances, peers, scale, data) -> None:
         "the entry node of each set. **SOP and PCGTSP: n/a** — elkai 2.0.1's in-memory reader crashes on "
         "`TYPE: SOP` (it reads the SOP dimension line from a null file: segfault in `Read_EDGE_WEIGHT_SECTION`), "
         "and LKH-3 has no precedence-constrained GTSP type.",
+        "- † LKH-3 produced no tour within `TOTAL_TIME_LIMIT` (its preprocessing alone exceeded the limit) and was "
+        "re-run with `TIME_LIMIT` only, which does not limit the preprocessing: its cost is then not at the same "
+        "budget; see its time column.",
+        "- PCGTSP references are the `index.csv` upper bounds (one PCGLNS heuristic run each), not optima: "
+        "negative gaps mean a better tour than that run. MIP-proven optima published with the same instances "
+        "(ukoloff/PCGTSP-BnB `Salman/output`, priced by towpath's model in "
+        "`crates/towpath-formats/tests/shared_data.rs`, ESC25 in the fixtures): ESC25 1383, ESC47 1063, prob.42 202.",
         "- **fast-tsp** `find_tour(matrix, duration_seconds=limit, max_threads=threads)`: symmetric TSP only "
         "(its documentation: the local search relies on symmetry), so ATSP/SOP/GTSP/PCGTSP are n/a.",
         "- **ortools** routing with `GUIDED_LOCAL_SEARCH` and the time limit, one thread: TSP/ATSP directly; SOP as "

@@ -367,6 +367,10 @@ def summarize(results: list[dict]) -> Cell:
         cell.note = "; ".join(reasons)
     elif len(feasible) < len(results):
         cell.note = f"{len(feasible)}/{len(results)} feasible"
+    # Footnotes a solver's worker attached to its answers (they start with a dagger).
+    marks = sorted({r["note"][0] for r in feasible if r.get("note", "").startswith("†")})
+    if marks:
+        cell.note = " ".join(filter(None, [cell.note, *marks]))
     return cell
 
 
