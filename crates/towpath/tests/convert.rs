@@ -56,8 +56,12 @@ fn converted_answer_prices_the_same(file: &str, matrix: bool) {
             original.steps_from_nodes(&nodes).unwrap()
         }
         _ => {
-            let nodes: Vec<u32> =
-                answer["tour"].as_array().unwrap().iter().map(|s| s["task"].as_str().unwrap().parse().unwrap()).collect();
+            let nodes: Vec<u32> = answer["tour"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|s| s["task"].as_str().unwrap().parse().unwrap())
+                .collect();
             original.steps_from_nodes(&nodes).unwrap()
         }
     };
@@ -102,7 +106,8 @@ fn refuses_to_overwrite_the_input_and_bad_files() {
     assert_eq!(std::fs::read(&copy).unwrap(), before, "the input is untouched");
 
     let bad = dir.join("bad.tsp");
-    std::fs::write(&bad, "NAME: bad\nTYPE: TSP\nDIMENSION: 2\nEDGE_WEIGHT_TYPE: EUC_2D\nNODE_COORD_SECTION\n1 0 x\n").unwrap();
+    std::fs::write(&bad, "NAME: bad\nTYPE: TSP\nDIMENSION: 2\nEDGE_WEIGHT_TYPE: EUC_2D\nNODE_COORD_SECTION\n1 0 x\n")
+        .unwrap();
     let out = towpath(&["convert", bad.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("bad.tsp:6"), "{}", String::from_utf8_lossy(&out.stderr));
