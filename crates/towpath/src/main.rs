@@ -17,12 +17,23 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run the built-in demo: a generated part, sequenced and checked, with no files of your own.
+    /// Run the built-in demo: seed 000's AFP parts written, optimized, verified and reported.
     Demo(cmd::demo::Args),
     /// Solve a TSPLIB (TSP, ATSP, SOP), GTSP-LIB, PCGLNS or towpath JSON problem file.
     Solve(cmd::solve::Args),
     /// Write a problem file (TSPLIB, GTSP-LIB, PCGLNS, JSON) as towpath JSON, optionally with an explicit matrix.
     Convert(cmd::convert::Args),
+    /// Generate the fiber courses of a ply on a mold surface (mesh or analytic), trimmed per tow,
+    /// with quality figures; write JSON, CSV and G-code.
+    Layup(Box<cmd::layup::Args>),
+    /// Re-sequence an AFP program: same part, laid identically, less off-part motion, verified.
+    Optimize(cmd::optimize::Args),
+    /// Check an optimized AFP program against its original and print the savings.
+    Verify(cmd::verify::Args),
+    /// Integrate separate tool paths into one open route over a travel graph (seed 004's open rural postman).
+    Route(cmd::route::Args),
+    /// Run a benchmark and print (or write into BENCHMARKS.md) its tables.
+    Bench(cmd::bench::Args),
 }
 
 fn main() {
@@ -31,6 +42,11 @@ fn main() {
         Command::Demo(args) => cmd::demo::run(args),
         Command::Solve(args) => cmd::solve::run(args),
         Command::Convert(args) => cmd::convert::run(args),
+        Command::Layup(args) => cmd::layup::run(*args),
+        Command::Optimize(args) => cmd::optimize::run(args),
+        Command::Verify(args) => cmd::verify::run(args),
+        Command::Route(args) => cmd::route::run(args),
+        Command::Bench(args) => cmd::bench::run(args),
     };
     std::process::exit(exit::report(result));
 }

@@ -1,6 +1,8 @@
 //! Construction heuristics: nearest neighbour (with the seed-000 seed pool) and a space-filling
 //! curve for very large instances. Both respect precedence and consecutive groups.
 
+use std::time::Instant;
+
 use super::net::Net;
 use crate::cost::{Cost, CostModel};
 use crate::model::{TaskId, NO_GROUP};
@@ -10,7 +12,11 @@ pub(crate) type Seq = (Vec<u32>, Vec<u32>);
 
 /// Nearest-neighbour construction. `first` picks the first task when the route has no fixed
 /// start (ignored otherwise; it must have no predecessors).
-pub(crate) fn nearest_neighbor<C: CostModel>(net: &Net<C>, first: Option<u32>) -> Seq {
+pub(crate) fn nearest_neighbor<C: CostModel>(
+    net: &Net<C>,
+    first: Option<u32>,
+    deadline: Option<Instant>,
+) -> Option<Seq> {
     let mut b = Builder::new(net);
     let has_depot = net.depot != u32::MAX;
     let mut cur = u32::MAX;
@@ -30,6 +36,9 @@ pub(crate) fn nearest_neighbor<C: CostModel>(net: &Net<C>, first: Option<u32>) -
         }
     }
     while b.seq.len() < net.n {
+        if b.seq.len() % 64 == 0 && deadline.is_some_and(|d| Instant::now() >= d) {
+            return None;
+        }
         let cm = if cur == u32::MAX { 0 } else { b.mode[cur as usize] };
         let mut best: (Cost, u32, u32) = (Cost::INFINITY, u32::MAX, 0);
         for &u in b.avail.iter() {
@@ -54,7 +63,7 @@ pub(crate) fn nearest_neighbor<C: CostModel>(net: &Net<C>, first: Option<u32>) -
     let mut seq = b.seq;
     let mode = b.mode;
     rotate_to_anchor(net, &mut seq);
-    (seq, mode)
+    Some((seq, mode))
 }
 
 /// Bookkeeping for constructions that add tasks one at a time while keeping precedence and

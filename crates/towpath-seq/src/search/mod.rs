@@ -59,7 +59,7 @@ pub struct SolveOptions {
     /// Set to true to stop the search early; the best route so far is returned.
     pub cancel: Option<Arc<AtomicBool>>,
     /// Problems with at most this many tasks (and at most 6 modes per task) are solved exactly
-    /// by dynamic programming instead (default 9).
+    /// by dynamic programming instead (default 10).
     pub exact_up_to: usize,
 }
 
@@ -73,7 +73,7 @@ impl Default for SolveOptions {
             initial: None,
             progress: None,
             cancel: None,
-            exact_up_to: 9,
+            exact_up_to: 10,
         }
     }
 }
@@ -153,38 +153,43 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         }
     }
     if starts.is_empty() {
-        let pool_size = ((2e7 / work.max(1.0)) as usize).clamp(1, 64);
+        // The seed pool is sized to the work (at most ~2·10⁷ arc evaluations) and, under a time
+        // limit, to about a twentieth of it (an arc evaluation taken as ~5 ns).
+        let mut pool_size = ((2e7 / work.max(1.0)) as usize).clamp(1, 64);
+        if let Some(tl) = opts.time_limit {
+            let affordable = tl.as_secs_f64() * 0.05 / (work.max(1.0) * 5e-9);
+            pool_size = pool_size.min(affordable as usize).max(1);
+        }
         let pool = if net.depot != u32::MAX && problem.start().is_some() {
             vec![0]
         } else {
             construct::seed_pool(&net, pool_size)
         };
+        // Stop early at the deadline, but always end with at least one start.
+        let have_initial = opts.initial.is_some();
         for f in pool {
-            let (seq, mode) = construct::nearest_neighbor(&net, Some(f));
-            if seq.len() == net.n {
-                starts.push(Tour::new(&net, seq, mode));
+            let limit = if starts.is_empty() && !have_initial { None } else { deadline };
+            match construct::nearest_neighbor(&net, Some(f), limit) {
+                Some((seq, mode)) if seq.len() == net.n => starts.push(Tour::new(&net, seq, mode)),
+                Some(_) => {}
+                None => break,
             }
         }
     }
-    if let Some(steps) = &opts.initial {
-        starts.push(tour_from_steps(&net, steps));
-    }
-    let eps = {
-        let c = starts.iter().map(|t| t.cost).filter(|c| c.is_finite()).fold(0.0, f64::max);
-        1e-9 * (c / n.max(1) as f64).max(1.0)
-    };
+    let eps = 1e-9 * net.typical_arc;
     let k = if n > 20_000 { 8 } else { 10 };
     let nb = Neighbors::build(&net, k);
     let ils = Ils::new(&net, &nb, eps);
-    // Descend from the best few starts; keep the best local optimum.
+    // Descend from the best few constructed starts and from the initial route; keep the best
+    // local optimum.
     starts.sort_by(|a, b| a.cost.total_cmp(&b.cost));
-    let keep = if opts.initial.is_some() { starts.len() } else { starts.len().min(3) };
+    let few = if pool_is_short(opts, work) { 1 } else { 3 };
+    starts.truncate(few);
+    if let Some(steps) = &opts.initial {
+        starts.push(tour_from_steps(&net, steps));
+    }
     let mut best: Option<Tour> = None;
-    for (idx, mut t) in starts.into_iter().enumerate() {
-        let is_initial = opts.initial.is_some() && idx + 1 == keep;
-        if idx >= keep && !is_initial {
-            continue;
-        }
+    for mut t in starts {
         ils.descend(&mut t, deadline);
         if best.as_ref().is_none_or(|b| t.cost < b.cost) {
             best = Some(t);
@@ -269,6 +274,11 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         }
     }
     Ok(SolveReport { solution, initial_cost, first_local_optimum, iterations, elapsed: t0.elapsed(), exact: false })
+}
+
+/// True when the time limit is too short to spend on descending from several starts.
+fn pool_is_short(opts: &SolveOptions, work: f64) -> bool {
+    opts.time_limit.is_some_and(|tl| tl.as_secs_f64() * 0.05 < 3.0 * work * 5e-9 * 4.0)
 }
 
 fn optimize_final<C: CostModel>(net: &Net<C>, tour: &mut Tour, eps: Cost) {

@@ -8,6 +8,9 @@
 use crate::cost::{Cost, CostModel, StateId};
 use crate::model::{End, Problem, NO_GROUP};
 
+/// The least price the search puts on a forbidden (non-finite) transition; see [`Net::forbidden`].
+const MIN_FORBIDDEN: Cost = 1e12;
+
 /// Marks "no reverse mode".
 pub(crate) const NO_REV: u32 = u32::MAX;
 
@@ -55,6 +58,12 @@ pub(crate) struct Net<'p, C> {
     group: Vec<u32>,
     pub has_groups: bool,
     pub multi_mode: bool,
+    /// The price of a forbidden transition in the search: at least 10¹², and a million times the
+    /// largest sampled finite cost; far above any real route, finite so that sums and
+    /// differences stay meaningful. The checker refuses routes that use one.
+    pub forbidden: Cost,
+    /// Mean of a sample of finite transition costs (at least 1).
+    pub typical_arc: Cost,
 }
 
 impl<'p, C: CostModel> Net<'p, C> {
@@ -152,7 +161,12 @@ impl<'p, C: CostModel> Net<'p, C> {
             group,
             has_groups: !p.groups().is_empty(),
             multi_mode: p.max_modes() > 1,
+            forbidden: f64::INFINITY,
+            typical_arc: 1.0,
         };
+        let (mean, max) = net.sample_arcs();
+        net.typical_arc = mean;
+        net.forbidden = (max * 1e6).max(MIN_FORBIDDEN);
         net.wrap_ok = net.reversal_symmetric && depot_symmetric && !net.has_prec && !net.has_groups;
         net
     }
@@ -173,13 +187,20 @@ impl<'p, C: CostModel> Net<'p, C> {
         if v == self.depot {
             0.0
         } else {
-            self.mcost[(self.mode_base[v as usize] + m) as usize]
+            self.mcost[(self.mode_base[v as usize] + m) as usize].min(self.forbidden)
         }
     }
 
-    /// Transition cost from node `a` in mode `ma` to node `b` in mode `mb`.
+    /// Transition cost from node `a` in mode `ma` to node `b` in mode `mb`, with forbidden
+    /// (non-finite) transitions priced at `self.forbidden` so that cost differences stay finite.
     #[inline]
     pub fn arc(&self, a: u32, ma: u32, b: u32, mb: u32) -> Cost {
+        // `min` maps +inf and NaN to the forbidden price
+        self.raw_arc(a, ma, b, mb).min(self.forbidden).max(-self.forbidden)
+    }
+
+    #[inline]
+    fn raw_arc(&self, a: u32, ma: u32, b: u32, mb: u32) -> Cost {
         if a == self.depot {
             if b == self.depot {
                 return match (self.p.start(), self.back) {
@@ -202,6 +223,32 @@ impl<'p, C: CostModel> Net<'p, C> {
                 self.entry[(self.mode_base[b as usize] + mb) as usize],
             )
         }
+    }
+
+    /// The mean and the largest of a deterministic sample of finite transition costs (at
+    /// least 1): the scale for "equal within rounding" and for the forbidden price.
+    fn sample_arcs(&self) -> (Cost, Cost) {
+        let n = self.n_tasks as u32;
+        if n < 2 {
+            return (1.0, 1.0);
+        }
+        let (mut sum, mut count, mut max) = (0.0, 0u32, 1.0f64);
+        let step = (n / 64).max(1);
+        for a in (0..n).step_by(step as usize) {
+            for k in 1..=16u32.min(n - 1) {
+                let b = (a + k * 7919) % n;
+                if a != b {
+                    let c = self.raw_arc(a, 0, b, 0);
+                    if c.is_finite() {
+                        sum += c.abs();
+                        count += 1;
+                        max = max.max(c.abs());
+                    }
+                }
+            }
+        }
+        let mean = if count == 0 { 1.0 } else { (sum / count as f64).max(1.0) };
+        (mean, max)
     }
 
     /// The reverse mode of `(v, m)`, or `NO_REV`.

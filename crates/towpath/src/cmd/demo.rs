@@ -1,17 +1,36 @@
-//! `towpath demo`: a built-in part, sequenced and checked, with no files of the user's own.
+//! `towpath demo`: the whole AFP flow on built-in parts, with no files of the user's own.
+//!
+//! Writes seed 000's test parts (planar base ply and pad-ups at 0°, 45° and 90°, and three
+//! cylinders) as programs, with the machine and dialect files, into a directory; optimizes each
+//! (bidirectional, course-level precedence); writes the optimized program and an HTML report;
+//! verifies the output independently; and prints the savings beside seed 000's.
 
+use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::Context;
-use rand::{Rng, SeedableRng};
-use towpath_seq::{check, solve, Metric, Mode, PointCost, Problem, SolveOptions, StateId};
+use towpath_machine::CostKind;
+use towpath_nc::demo::{demo_parts, gantry, mandrel_machine, TOW_WIDTH};
+use towpath_nc::{optimize, parse, verify, AfpOptions, Dialect, OptimizeOptions, Report, VerifyOptions};
+
+use super::afp_common::write;
+use crate::exit;
 
 /// Arguments of `towpath demo`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Time limit for the solver, in seconds.
-    #[arg(long, default_value_t = 2.0)]
+    /// Directory to write the programs, machines, optimized programs and reports into.
+    #[arg(long, default_value = "towpath-demo", value_name = "DIR")]
+    pub dir: PathBuf,
+    /// Solver time limit per part, in seconds.
+    #[arg(long, default_value_t = 0.3, value_name = "S")]
     pub time_limit: f64,
+    /// Cost model to optimize.
+    #[arg(long, default_value = "axis", value_name = "axis|time|tool")]
+    pub cost: CostKind,
+    /// Keep every course in its original direction.
+    #[arg(long)]
+    pub unidirectional: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -19,48 +38,93 @@ pub struct Args {
 
 /// Runs the demo.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    // 400 straight strokes on a 1 m × 1 m plate, each drawable in either direction, badly
-    // ordered as given: the sequencer chooses order and direction.
-    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(7);
-    let mut pts = Vec::new();
-    for _ in 0..400 {
-        let (x, y) = (rng.gen_range(0.0..1000.0), rng.gen_range(0.0..1000.0));
-        let a: f64 = rng.gen_range(0.0..std::f64::consts::PI);
-        let l = rng.gen_range(10.0..60.0);
-        pts.push([x, y, 0.0]);
-        pts.push([x + l * a.cos(), y + l * a.sin(), 0.0]);
+    if !(args.time_limit.is_finite() && args.time_limit >= 0.0) {
+        return Err(exit::bad_input(anyhow::anyhow!("--time-limit {}: give a number of seconds ≥ 0", args.time_limit)));
     }
-    let mut b = Problem::builder(PointCost::new(pts, Metric::Euclidean));
-    for k in 0..400u32 {
-        let (s, e) = (StateId(2 * k), StateId(2 * k + 1));
-        b.task(vec![Mode::new(s, e), Mode::new(e, s)]);
-    }
-    let problem = b.build().context("building the demo problem")?;
-    let initial: Vec<towpath_seq::Step> = problem.tasks().map(|t| towpath_seq::Step { task: t, mode: 0 }).collect();
-    let opts = SolveOptions {
+    let dir = &args.dir;
+    let dialect = Dialect { tow_width: Some(TOW_WIDTH), ..Dialect::default() };
+    write(&dir.join("gantry-afp.toml"), &gantry().to_toml_string())?;
+    write(&dir.join("mandrel-afp.toml"), &mandrel_machine().to_toml_string())?;
+    write(&dir.join("dialect.toml"), &dialect.to_toml_string())?;
+    let afp = AfpOptions { cost: args.cost, bidirectional: !args.unidirectional, ..AfpOptions::default() };
+    let opts = OptimizeOptions {
+        afp: afp.clone(),
         time_limit: Some(Duration::from_secs_f64(args.time_limit)),
-        initial: Some(initial),
-        ..SolveOptions::default()
+        ..OptimizeOptions::default()
     };
-    let report = solve(&problem, &opts)?;
-    let checked = check(&problem, &report.solution.steps)?;
-    let before = report.initial_cost.unwrap_or(f64::NAN);
-    if args.json {
+    if !args.json {
+        println!("towpath demo: seed 000's AFP test parts, written to {}/", dir.display());
         println!(
-            "{}",
-            serde_json::json!({
-                "tasks": problem.num_tasks(),
-                "travel_before": before,
-                "travel_after": checked,
-                "saved_percent": 100.0 * (before - checked) / before,
-                "seconds": report.elapsed.as_secs_f64(),
-            })
+            "Each program is planned badly on purpose: plies out of order, every course laid in the same direction.\n\
+             towpath re-sequences the courses ({}, a course after the courses of earlier plies it overlaps),\n\
+             rewrites only the off-part motion, and verifies the result independently.\n",
+            if args.unidirectional { "unidirectional" } else { "bidirectional" }
         );
+        println!(
+            "{:<22} {:>7} {:>24} {:>8} {:>9} {:>13} {:>9}",
+            "part",
+            "courses",
+            format!("off-part ({})", args.cost),
+            "saved",
+            "seed 000",
+            "total (tool)",
+            "verified"
+        );
+    }
+    let mut rows = Vec::new();
+    for part in demo_parts() {
+        let prog_path = dir.join(format!("{}.nc", part.name));
+        let out_path = dir.join(format!("{}.opt.nc", part.name));
+        write(&prog_path, &part.program)?;
+        let o = optimize(&part.program, &part.machine, &dialect, &opts)
+            .with_context(|| format!("optimizing the demo part {}", part.name))?;
+        write(&out_path, &o.text)?;
+        let report = Report::new(&format!("{}.nc", part.name), &part.machine, &o, &afp);
+        let optimized = parse(&o.text, &part.machine, &dialect)?;
+        write(&dir.join(format!("{}.html", part.name)), &report.to_html(&o, &optimized, &part.machine))?;
+        // The whole flow: verify the written output again, from the texts alone.
+        let v = verify(&part.program, &o.text, &part.machine, &dialect, &VerifyOptions::default())
+            .map_err(|e| exit::check_failed(anyhow::anyhow!("{}: {e}", out_path.display())))?;
+        let t = report.total(args.cost).cloned();
+        let tool = report.total(CostKind::Tool).cloned();
+        let (seed_off, seed_total) = part.seed.map_or((f64::NAN, f64::NAN), |s| (s.1, s.2));
+        if !args.json {
+            if let Some(t) = &t {
+                println!(
+                    "{:<22} {:>7} {:>24} {:>7.1}% {:>9} {:>12.1}% {:>9}",
+                    part.name,
+                    v.courses,
+                    format!("{:.0} -> {:.0}", t.off_before, t.off_after),
+                    t.off_saved_percent,
+                    if seed_off.is_nan() { "-".to_string() } else { format!("{seed_off:.1}%") },
+                    tool.as_ref().map_or(f64::NAN, |x| x.total_saved_percent),
+                    "yes"
+                );
+            }
+        }
+        rows.push(serde_json::json!({
+            "part": part.name,
+            "description": part.description,
+            "courses": v.courses,
+            "reversed": v.reversed,
+            "totals": report.totals,
+            "seed_000_off_part_saved_percent": if seed_off.is_nan() { None } else { Some(seed_off) },
+            "seed_000_total_saved_percent": if seed_total.is_nan() { None } else { Some(seed_total) },
+            "program": prog_path,
+            "optimized": out_path,
+            "seconds": o.timings.total,
+        }));
+    }
+    if args.json {
+        println!("{}", serde_json::json!({ "dir": dir, "parts": rows }));
     } else {
-        println!("towpath demo: 400 strokes on a plate, order and direction free");
-        println!("  off-part travel as given : {before:>10.1} mm");
-        println!("  off-part travel sequenced: {checked:>10.1} mm ({:.1} % less)", 100.0 * (before - checked) / before);
-        println!("  solver time              : {:>10.2} s", report.elapsed.as_secs_f64());
+        println!(
+            "\nOpen {}/planar-45.html for a before/after plan view. To run one part yourself:\n  \
+             towpath optimize {0}/planar-45.nc --machine {0}/gantry-afp.toml --dialect {0}/dialect.toml \\\n    \
+             --bidirectional -o planar-45.opt.nc --report planar-45.html\n  \
+             towpath verify {0}/planar-45.nc planar-45.opt.nc --machine {0}/gantry-afp.toml --dialect {0}/dialect.toml",
+            dir.display()
+        );
     }
     Ok(())
 }

@@ -1,0 +1,83 @@
+//! What every baseline shares: the clock (time limit and cancel flag) and the last step that
+//! checks the answer, keeps the initial route if it is better, and fills in the report.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
+
+use towpath_seq::{check, CostModel, Problem, Solution, SolveOptions, SolveReport, Step};
+
+use crate::BaselineError;
+
+/// Wall time and cancellation for a run.
+pub(crate) struct Clock {
+    pub t0: Instant,
+    deadline: Option<Instant>,
+    cancel: Option<Arc<AtomicBool>>,
+}
+
+impl Clock {
+    pub fn new(opts: &SolveOptions) -> Self {
+        let t0 = Instant::now();
+        Clock { t0, deadline: opts.time_limit.map(|d| t0 + d), cancel: opts.cancel.clone() }
+    }
+
+    /// True once the time limit has passed or the run was cancelled.
+    pub fn expired(&self) -> bool {
+        self.deadline.is_some_and(|d| Instant::now() >= d)
+            || self.cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+}
+
+/// Checks the initial route given in the options, if any, and returns its cost.
+pub(crate) fn initial_cost<C: CostModel>(
+    problem: &Problem<C>,
+    opts: &SolveOptions,
+) -> Result<Option<f64>, BaselineError> {
+    match &opts.initial {
+        Some(steps) => Ok(Some(check(problem, steps).map_err(BaselineError::BadInitial)?)),
+        None => Ok(None),
+    }
+}
+
+/// Checks the route a baseline found and builds the report. If an initial route was given and
+/// is cheaper, it is returned instead (seed 000 §3.2 requirement 4: F(p) ≤ F(o)).
+pub(crate) fn finish<C: CostModel>(
+    problem: &Problem<C>,
+    steps: Vec<Step>,
+    opts: &SolveOptions,
+    clock: &Clock,
+    first_cost: f64,
+    iterations: u64,
+) -> Result<SolveReport, BaselineError> {
+    let initial_cost = initial_cost(problem, opts)?;
+    let mut solution = match check(problem, &steps) {
+        Ok(cost) => Some(Solution { steps, cost }),
+        Err(v) => {
+            if initial_cost.is_none() {
+                return Err(BaselineError::NoFeasibleRoute(v));
+            }
+            None
+        }
+    };
+    if let (Some(init), Some(ic)) = (&opts.initial, initial_cost) {
+        if solution.as_ref().is_none_or(|s| ic < s.cost) {
+            solution = Some(Solution { steps: init.clone(), cost: ic });
+        }
+    }
+    let Some(solution) = solution else {
+        // unreachable: either the route checked or the initial one exists
+        return Err(BaselineError::NoFeasibleRoute(towpath_seq::Violation::WrongLength {
+            got: 0,
+            expected: problem.num_tasks(),
+        }));
+    };
+    Ok(SolveReport {
+        solution,
+        initial_cost,
+        first_local_optimum: first_cost,
+        iterations,
+        elapsed: clock.t0.elapsed(),
+        exact: false,
+    })
+}

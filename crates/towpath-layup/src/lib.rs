@@ -1,0 +1,25 @@
+//! towpath-layup: AFP course generation on mold surfaces.
+//!
+//! - [`field`]: design directions (rosette axis, guide curves, orientation samples) with the ply
+//!   angle (seed 001 Algorithms 3 and 5, seed 002 eq. 6).
+//! - [`trace`]: course tracing across triangles in both directions (seed 001 Algorithm 4), field
+//!   steered or geodesic, with smooth normals.
+//! - [`ply`]: covering a ply with parallel courses (seed 002 §3–4) — [`ply::plan`] is the entry
+//!   point — with [`section`] trimming every tow at the ply boundary ([`boundary`]) under a
+//!   coverage rule, and [`quality`] figures.
+//! - [`accuracy`]: deviations from closed-form geodesics on analytic surfaces (seed 001 §4).
+//! - [`output`]: courses as JSON, CSV and a G-code program.
+
+// `!(a > b)` is used on purpose: it is also true when a or b is NaN, which input checks rely on.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod accuracy;
+pub mod boundary;
+pub mod course;
+pub mod field;
+pub mod input;
+pub mod output;
+pub mod ply;
+pub mod quality;
+pub mod section;
+pub mod trace;

@@ -1,0 +1,612 @@
+//! Covering a ply with courses (seed 002 §3–4): a reference course through the start point, then
+//! parallel courses offset by one course width measured on the surface, on both sides, until the
+//! ply is covered; every course trimmed per tow at the ply boundary.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use towpath_geom::Mesh;
+
+use crate::boundary::Region;
+use crate::course::Course;
+use crate::field::DirectionField;
+use crate::quality::{self, PlyQuality};
+use crate::section::{Band, Coverage, Sectioner};
+use crate::trace::{reverse_walk, tangent, transport, walk, Located, PathPoint, Steering, Stop, WalkOptions};
+use towpath_geom::NO_FACE;
+
+/// How courses follow the design.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Every course follows the design direction (fixed angle, guide curves or orientation
+    /// samples): the fiber angle is exact, the spacing between courses varies (gaps/overlaps).
+    Field,
+    /// The reference course is a geodesic from the start point in the design direction; every
+    /// other course is its geodesic parallel one course width away (seed 002's equidistant
+    /// method): no gaps or overlaps, the fiber angle drifts and courses may need steering.
+    Parallel,
+    /// Every course is a geodesic (a natural path: no steering at all), started on the seed curve
+    /// in the design direction there: the angle holds at the seeds, gaps/overlaps elsewhere.
+    Natural,
+}
+
+/// What to generate.
+#[derive(Debug, Clone)]
+pub struct PlySpec {
+    /// Tow width (mm).
+    pub tow_width: f64,
+    /// Tows per course.
+    pub tows: usize,
+    /// Course method.
+    pub method: Method,
+    /// Coverage rule at the boundary.
+    pub coverage: Coverage,
+    /// Minimum steering radius for quality flags (mm).
+    pub min_steering_radius: f64,
+    /// Start point of the reference course (projected onto the mesh); `None`: the point of the ply
+    /// nearest its centroid.
+    pub start: Option<DVec3>,
+    /// Upper bound on the number of courses.
+    pub max_courses: usize,
+    /// Spacing of trimming stations along a course (mm).
+    pub station_step: f64,
+}
+
+impl PlySpec {
+    /// Defaults for a band of `tows` tows of width `tow_width`: field method, 50 % coverage,
+    /// minimum steering radius 100 tow widths (635 mm for 6.35 mm tows).
+    pub fn new(tow_width: f64, tows: usize) -> PlySpec {
+        PlySpec {
+            tow_width,
+            tows,
+            method: Method::Field,
+            coverage: Coverage::Half,
+            min_steering_radius: 100.0 * tow_width,
+            start: None,
+            max_courses: 10_000,
+            station_step: tow_width.min(5.0),
+        }
+    }
+    fn band(&self) -> Band {
+        Band { tow_width: self.tow_width, tows: self.tows }
+    }
+}
+
+/// A planned ply.
+#[derive(Debug, Clone, Serialize)]
+pub struct Ply {
+    /// Courses from right to left (looking along the fiber, normal up).
+    pub courses: Vec<Course>,
+    /// Courses generated to the left (+) of the reference course (seed 002's N₁).
+    pub n1: usize,
+    /// Courses generated to the right (−) of the reference course (N₂).
+    pub n2: usize,
+    /// Seed 002 eq. 9 estimate ⌈max section length / course width⌉ on each side (left, right),
+    /// from sections across the reference course.
+    pub n_estimate: [usize; 2],
+    /// Quality figures.
+    pub quality: PlyQuality,
+    /// Time spent planning (s).
+    pub seconds: f64,
+    /// Where the time went (s): centreline tracing, trimming, quality.
+    pub timings: Timings,
+}
+
+/// Time per phase of [`plan`], seconds.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct Timings {
+    /// Tracing and offsetting centrelines.
+    pub courses: f64,
+    /// Per-tow trimming.
+    pub trim: f64,
+    /// Quality figures.
+    pub quality: f64,
+}
+
+/// Errors of ply planning.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlyError {
+    /// Tow width or count not positive.
+    #[error("tow width must be positive and the tow count between 1 and 64 (got {0} mm × {1})")]
+    BadBand(f64, usize),
+    /// The design direction is undefined at the start.
+    #[error("the design direction is undefined at the start point {0:?} (reference axis along the surface normal?)")]
+    NoDirection([f64; 3]),
+    /// The start point is outside the ply.
+    #[error("the start point {0:?} lies outside the ply boundary")]
+    StartOutside([f64; 3]),
+    /// Nothing to start from.
+    #[error("the mesh is empty")]
+    Empty,
+}
+
+/// Progress report: courses generated so far.
+pub type Progress<'a> = &'a mut dyn FnMut(usize);
+
+struct Planner<'a> {
+    mesh: &'a Mesh,
+    field: &'a dyn DirectionField,
+    region: &'a Region,
+    spec: &'a PlySpec,
+    /// Course centreline points laid so far (for wrap-around detection): a coarse grid.
+    grid: std::collections::HashMap<[i64; 3], Vec<DVec3>>,
+    max_len: f64,
+}
+
+/// Plans a ply: reference course, offsets on both sides, trimming, quality.
+pub fn plan(
+    mesh: &Mesh,
+    field: &dyn DirectionField,
+    region: &Region,
+    spec: &PlySpec,
+    progress: Progress<'_>,
+) -> Result<Ply, PlyError> {
+    let t0 = Instant::now();
+    if !(spec.tow_width > 0.0 && spec.tow_width.is_finite()) || spec.tows == 0 || spec.tows > 64 {
+        return Err(PlyError::BadBand(spec.tow_width, spec.tows));
+    }
+    if mesh.num_faces() == 0 {
+        return Err(PlyError::Empty);
+    }
+    let mut timings = Timings::default();
+    let tp = Instant::now();
+    let (lo, hi) = mesh.bounds();
+    let diag = (hi - lo).length();
+    let mut pl = Planner { mesh, field, region, spec, grid: Default::default(), max_len: 3.0 * diag };
+    let start_pt = spec.start.unwrap_or_else(|| default_start(mesh, region));
+    let sp = mesh.closest_point(start_pt).ok_or(PlyError::Empty)?;
+    let start = Located::new(mesh, sp);
+    if region.has_curve() && region.curve_distance(start.p) < 0.0 {
+        return Err(PlyError::StartOutside(start.p.to_array()));
+    }
+    let d0 = field.direction(start.p, start.n).ok_or(PlyError::NoDirection(start.p.to_array()))?;
+    let method_steer = match spec.method {
+        Method::Field => Steering::Field(field),
+        Method::Parallel | Method::Natural => Steering::Geodesic,
+    };
+    let reference = pl.trace(start, d0, method_steer);
+    pl.remember(&reference);
+    let mut done = 1usize;
+    progress(done);
+    let n_estimate = pl.estimate(&reference);
+    let mut sides: [Vec<Vec<PathPoint>>; 2] = [Vec::new(), Vec::new()];
+    for (si, sign) in [(0usize, 1.0f64), (1, -1.0)] {
+        let mut prev = reference.clone();
+        while done < spec.max_courses {
+            let next = match spec.method {
+                Method::Parallel => pl.parallel(&prev, sign),
+                Method::Field | Method::Natural => pl.seeded(&prev, sign, method_steer),
+            };
+            let Some(next) = next else { break };
+            pl.remember(&next);
+            done += 1;
+            progress(done);
+            sides[si].push(next.clone());
+            prev = next;
+        }
+    }
+    let [left, right] = sides;
+    let (n1, n2) = (left.len(), right.len());
+    // Lateral order: rightmost first.
+    let mut lines: Vec<(i8, usize, Vec<PathPoint>)> = Vec::new();
+    for (i, c) in right.into_iter().enumerate().rev() {
+        lines.push((-1, i + 1, c));
+    }
+    lines.push((0, 0, reference));
+    for (i, c) in left.into_iter().enumerate() {
+        lines.push((1, i + 1, c));
+    }
+    timings.courses = tp.elapsed().as_secs_f64();
+    let tp = Instant::now();
+    let sectioner = Sectioner { mesh, region, band: spec.band() };
+    // Courses are trimmed independently (in parallel; the result does not depend on threads).
+    let prepared: Vec<(i8, usize, Vec<PathPoint>, Vec<bool>)> = lines
+        .into_iter()
+        .map(|(side, offset_index, pts)| {
+            let (pts, on) = pl.run_out(pts);
+            (side, offset_index, pts, on)
+        })
+        .collect();
+    let mut courses: Vec<Course> = prepared
+        .into_par_iter()
+        .map(|(side, offset_index, pts, on_surface)| {
+            let tows = sectioner.trim(&pts, spec.coverage, spec.station_step, 1e-3);
+            let mut c = Course { id: 0, side, offset_index, points: pts, on_surface, tows };
+            crop(&mut c);
+            c
+        })
+        .collect();
+    courses.retain(|c| c.laid_range().is_some());
+    for (i, c) in courses.iter_mut().enumerate() {
+        c.id = i;
+    }
+    timings.trim = tp.elapsed().as_secs_f64();
+    let tp = Instant::now();
+    let quality = quality::assess(mesh, field, region, spec, &courses);
+    timings.quality = tp.elapsed().as_secs_f64();
+    Ok(Ply { courses, n1, n2, n_estimate, quality, seconds: t0.elapsed().as_secs_f64(), timings })
+}
+
+/// The mesh (or ply) point nearest the area centroid.
+fn default_start(mesh: &Mesh, region: &Region) -> DVec3 {
+    if region.has_curve() {
+        let c = region.curve_points.iter().copied().sum::<DVec3>() / region.curve_points.len().max(1) as f64;
+        return c;
+    }
+    let mut acc = DVec3::ZERO;
+    let mut area = 0.0;
+    for f in 0..mesh.num_faces() as u32 {
+        let c = mesh.corners(f);
+        let a = mesh.face_area(f);
+        acc += (c[0] + c[1] + c[2]) / 3.0 * a;
+        area += a;
+    }
+    acc / area.max(1e-300)
+}
+
+impl Planner<'_> {
+    fn width(&self) -> f64 {
+        self.spec.tow_width * self.spec.tows as f64
+    }
+
+    fn key(&self, p: DVec3) -> [i64; 3] {
+        let f = p / self.width();
+        [f.x.floor() as i64, f.y.floor() as i64, f.z.floor() as i64]
+    }
+
+    fn remember(&mut self, pts: &[PathPoint]) {
+        let mut last: Option<DVec3> = None;
+        for q in pts {
+            if last.is_some_and(|l| l.distance(q.p) < 0.1 * self.width()) {
+                continue;
+            }
+            last = Some(q.p);
+            let k = self.key(q.p);
+            self.grid.entry(k).or_default().push(q.p);
+        }
+    }
+
+    /// Distance to the nearest remembered course point (within one course width; else ∞).
+    fn near_existing(&self, p: DVec3) -> f64 {
+        let c = self.key(p);
+        let mut best = f64::INFINITY;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    if let Some(v) = self.grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
+                        for q in v {
+                            best = best.min(q.distance(p));
+                        }
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// Whether a course centre at p would still put material in the ply.
+    fn useful(&self, p: DVec3) -> bool {
+        !self.region.has_curve() || self.region.curve_distance(p) > -0.5 * self.width()
+    }
+
+    /// The stop test of centreline traces: far outside the ply boundary.
+    fn outside_far(&self, p: DVec3) -> bool {
+        self.region.has_curve() && self.region.curve_distance(p) < -1.5 * self.width()
+    }
+
+    /// Traces a centreline in both directions from `start`. A closed loop (a hoop on a tube) is
+    /// closed once instead of wrapping again.
+    fn trace(&self, start: Located, d0: DVec3, steer: Steering<'_>) -> Vec<PathPoint> {
+        let w = self.width();
+        let opts = WalkOptions::up_to(self.max_len);
+        let d_start = match steer {
+            Steering::Field(f) => f.direction(start.p, start.n).map(|v| if v.dot(d0) < 0.0 { -v } else { v }),
+            Steering::Geodesic => tangent(d0, start.n),
+        };
+        let Some(d_start) = d_start else { return Vec::new() };
+        let mut closed = false;
+        let mut last = start.p;
+        let (mut fwd, _) = walk(self.mesh, start, d_start, steer, &opts, |q| {
+            if self.outside_far(q.p) {
+                return true;
+            }
+            // Back at the start (a hoop): the step from the previous point passes the start.
+            let seg = q.p - last;
+            let t = if seg.length_squared() > 0.0 {
+                ((start.p - last).dot(seg) / seg.length_squared()).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let near = (last + seg * t).distance(start.p);
+            last = q.p;
+            if q.s > 2.0 * w && near < 0.02 * w {
+                closed = true;
+                return true;
+            }
+            false
+        });
+        if closed {
+            // End the loop exactly at the start.
+            if let Some(l) = fwd.last_mut() {
+                *l = PathPoint { p: start.p, n: start.n, ..*l };
+            }
+        }
+        let bwd = if closed {
+            Vec::new()
+        } else {
+            walk(self.mesh, start, -d_start, steer, &opts, |q| self.outside_far(q.p)).0
+        };
+        let total_b = bwd.last().map_or(0.0, |q| q.s);
+        let mut pts = Vec::with_capacity(fwd.len() + bwd.len() + 1);
+        pts.extend(reverse_walk(&bwd, start.sp.face).into_iter().map(|q| PathPoint { s: total_b - q.s, ..q }));
+        let start_face = bwd.first().map_or(start.sp.face, |q| q.face);
+        pts.push(PathPoint { p: start.p, n: start.n, d: d_start, s: total_b, face: start_face });
+        for q in &fwd {
+            pts.push(PathPoint { s: total_b + q.s, ..*q });
+        }
+        pts
+    }
+
+    /// Walks `dist` along the surface from a course point, perpendicular to the fiber, towards
+    /// `sign` (+1 left). Returns the end located point and the transported fiber direction. When
+    /// the mesh ends first but more than half a tow of surface is left beyond the previous
+    /// course's edge, the point a quarter tow inside the mesh edge is returned instead (the last
+    /// course is shifted onto the surface; the overlap this makes is reported by the quality
+    /// figures).
+    fn across(&self, at: &PathPoint, sign: f64, dist: f64, allow_shift: bool) -> Option<(Located, DVec3)> {
+        let start = crate::course::locate(self.mesh, at.p, at.face)?;
+        let b = start.n.cross(at.d) * sign;
+        let opts = WalkOptions::up_to(dist);
+        let (mut w, stop) = walk(self.mesh, start, b, Steering::Geodesic, &opts, |_| false);
+        if stop != Stop::Length {
+            let reach = w.last().map_or(0.0, |q| q.s);
+            let tw = self.spec.tow_width;
+            if !allow_shift || stop != Stop::Boundary || reach < 0.5 * dist + 0.5 * tw {
+                return None;
+            }
+            let opts = WalkOptions::up_to(reach - 0.25 * tw);
+            let (w2, stop2) = walk(self.mesh, start, b, Steering::Geodesic, &opts, |_| false);
+            if stop2 != Stop::Length {
+                return None;
+            }
+            w = w2;
+        }
+        let end = w.last()?;
+        let loc = crate::course::locate(self.mesh, end.p, end.face)?;
+        let d = tangent(transport(at.d, start.n, loc.n), loc.n)?;
+        Some((loc, d))
+    }
+
+    /// Next course for the field and natural methods: seeded one course width across from the
+    /// previous course (at the point nearest the previous seed that lands in the ply and not on
+    /// an existing course), then traced.
+    fn seeded(&self, prev: &[PathPoint], sign: f64, steer: Steering<'_>) -> Option<Vec<PathPoint>> {
+        let w = self.width();
+        let len = prev.last()?.s;
+        // Candidate stations every w/2, nearest the middle first.
+        let mid = 0.5 * len;
+        let count = (len / (0.5 * w)).ceil() as usize + 1;
+        let mut cands: Vec<f64> = (0..count).map(|i| (i as f64 * 0.5 * w).min(len)).collect();
+        cands.sort_by(|a, b| (a - mid).abs().total_cmp(&(b - mid).abs()));
+        for s in cands {
+            let (p, n, d) = crate::course::frame_at(prev, s);
+            if !self.useful(p) {
+                continue;
+            }
+            let at = PathPoint { p, n, d, s, face: crate::course::face_hint(prev, s) };
+            let Some((loc, dt)) = self.across(&at, sign, w, true) else { continue };
+            if !self.useful(loc.p) || self.near_existing(loc.p) < 0.5 * w {
+                continue;
+            }
+            let d0 = match steer {
+                Steering::Field(f) => f.direction(loc.p, loc.n).map(|v| if v.dot(dt) < 0.0 { -v } else { v }),
+                Steering::Geodesic => {
+                    // Natural path: start in the design direction at the seed.
+                    self.field.direction(loc.p, loc.n).map(|v| if v.dot(dt) < 0.0 { -v } else { v })
+                }
+            };
+            let Some(d0) = d0 else { continue };
+            let pts = self.trace(loc, d0, steer);
+            if pts.len() >= 2 {
+                return Some(pts);
+            }
+        }
+        None
+    }
+
+    /// Next course for the parallel method: the geodesic offset of every station of the previous
+    /// course, extended at both ends along geodesics to the ply (seed 002 §4).
+    fn parallel(&self, prev: &[PathPoint], sign: f64) -> Option<Vec<PathPoint>> {
+        // Whole-width offsets first; only where none fits (the last strip before a mesh edge) is
+        // the course shifted onto the surface.
+        self.parallel_with(prev, sign, false).or_else(|| self.parallel_with(prev, sign, true))
+    }
+
+    fn parallel_with(&self, prev: &[PathPoint], sign: f64, allow_shift: bool) -> Option<Vec<PathPoint>> {
+        let w = self.width();
+        let len = prev.last()?.s;
+        let step = (0.1 * w).clamp(1.0, 10.0);
+        let count = (len / step).ceil() as usize;
+        let mut pts: Vec<PathPoint> = Vec::new();
+        for i in 0..=count {
+            let s = (i as f64 * step).min(len);
+            let (p, n, d) = crate::course::frame_at(prev, s);
+            let at = PathPoint { p, n, d, s, face: crate::course::face_hint(prev, s) };
+            let Some((loc, dt)) = self.across(&at, sign, w, allow_shift) else { continue };
+            // Drop points where the offset folds back (prev curves tighter than w on this side).
+            if let Some(last) = pts.last() {
+                if (loc.p - last.p).dot(last.d) <= 1e-9 {
+                    continue;
+                }
+            }
+            pts.push(PathPoint { p: loc.p, n: loc.n, d: dt, s: 0.0, face: NO_FACE });
+        }
+        let useful = pts.iter().filter(|q| self.useful(q.p)).count();
+        if useful == 0 {
+            return None;
+        }
+        let covered = pts.iter().filter(|q| self.near_existing(q.p) < 0.5 * w).count();
+        if covered * 2 > pts.len() {
+            return None; // wrapped onto existing courses (closed surface)
+        }
+        let closed = prev.len() > 2 && prev[0].p.distance(prev[prev.len() - 1].p) < 0.02 * w;
+        if closed {
+            // The offset of a closed course (a hoop) is closed too: no extension.
+            let mut all = pts;
+            if let Some(&first) = all.first() {
+                all.push(first);
+            }
+            let mut s = 0.0;
+            for i in 0..all.len() {
+                if i > 0 {
+                    s += all[i].p.distance(all[i - 1].p);
+                }
+                all[i].s = s;
+            }
+            return Some(all);
+        }
+        // Extend both ends geodesically until leaving the ply or the mesh.
+        let opts = WalkOptions::up_to(self.max_len);
+        let ext = |q: &PathPoint, dir: DVec3| -> Vec<PathPoint> {
+            let Some(loc) = crate::course::locate(self.mesh, q.p, q.face) else { return Vec::new() };
+            walk(self.mesh, loc, dir, Steering::Geodesic, &opts, |x| self.outside_far(x.p)).0
+        };
+        let first = *pts.first()?;
+        let last = *pts.last()?;
+        let head = ext(&first, -first.d);
+        let tail = ext(&last, last.d);
+        let mut all: Vec<PathPoint> = reverse_walk(&head, NO_FACE);
+        if let Some(first) = pts.first_mut() {
+            first.face = head.first().map_or(NO_FACE, |q| q.face);
+        }
+        all.extend(pts);
+        all.extend(tail);
+        let mut s = 0.0;
+        for i in 0..all.len() {
+            if i > 0 {
+                s += all[i].p.distance(all[i - 1].p);
+            }
+            all[i].s = s;
+        }
+        Some(all)
+    }
+
+    /// Adds straight run-outs beyond the mesh edge at ends where the centreline stopped on the
+    /// mesh boundary, so tows on the trailing side can be laid to the edge under the 50 % and 100 %
+    /// rules. Run-outs are at most one course width long and marked off the surface.
+    fn run_out(&self, mut pts: Vec<PathPoint>) -> (Vec<PathPoint>, Vec<bool>) {
+        let w = self.width();
+        let mut on = vec![true; pts.len()];
+        if pts.len() < 2 || self.spec.coverage == Coverage::Zero {
+            return (pts, on);
+        }
+        let near_edge = |p: DVec3| self.region.mesh_edges.distance(p) < 1e-6 * (1.0 + p.length());
+        let k = 4;
+        if let Some(&l) = pts.last() {
+            if near_edge(l.p) {
+                for i in 1..=k {
+                    let t = w * i as f64 / k as f64;
+                    pts.push(PathPoint { p: l.p + l.d * t, s: l.s + t, face: NO_FACE, ..l });
+                    on.push(false);
+                }
+            }
+        }
+        if let Some(&f) = pts.first() {
+            if near_edge(f.p) {
+                let mut head = Vec::new();
+                for i in (1..=k).rev() {
+                    let t = w * i as f64 / k as f64;
+                    head.push(PathPoint { p: f.p - f.d * t, s: f.s - t, face: NO_FACE, ..f });
+                }
+                let n = head.len();
+                if let Some(first) = pts.first_mut() {
+                    first.face = NO_FACE;
+                }
+                head.extend(pts);
+                pts = head;
+                let mut on2 = vec![false; n];
+                on2.extend(on);
+                on = on2;
+                let s0 = pts[0].s;
+                for q in &mut pts {
+                    q.s -= s0;
+                }
+            }
+        }
+        (pts, on)
+    }
+
+    /// Seed 002 eq. 9: the longest section across the reference course on each side, walked as a
+    /// geodesic perpendicular to the fiber until it leaves the ply, divided by the course width.
+    fn estimate(&self, reference: &[PathPoint]) -> [usize; 2] {
+        let w = self.width();
+        let Some(len) = reference.last().map(|q| q.s) else { return [0, 0] };
+        let mut best = [0.0f64; 2];
+        let count = (len / w).ceil().max(1.0) as usize;
+        for i in 0..=count {
+            let s = len * i as f64 / count as f64;
+            let (p, n, d) = crate::course::frame_at(reference, s);
+            if self.region.has_curve() && self.region.curve_distance(p) < 0.0 {
+                continue;
+            }
+            let Some(start) = crate::course::locate(self.mesh, p, crate::course::face_hint(reference, s)) else {
+                continue;
+            };
+            for (k, sign) in [(0usize, 1.0f64), (1, -1.0)] {
+                let b = n.cross(d) * sign;
+                let opts = WalkOptions::up_to(self.max_len);
+                let (wk, _) = walk(self.mesh, start, b, Steering::Geodesic, &opts, |q| {
+                    (self.region.has_curve() && self.region.curve_distance(q.p) < 0.0)
+                        || (q.s > w && q.p.distance(start.p) < 0.02 * w)
+                });
+                let l = wk.last().map_or(0.0, |q| q.s);
+                best[k] = best[k].max(l);
+            }
+        }
+        // The reference course covers half a width on each side.
+        let count = |l: f64| ((l - 0.5 * w).max(0.0) / w - 1e-6).ceil().max(0.0) as usize;
+        [count(best[0]), count(best[1])]
+    }
+}
+
+/// Crops a course's centreline to the range where tows are laid (with exact end points).
+fn crop(c: &mut Course) {
+    let Some([a, b]) = c.laid_range() else { return };
+    let (pa, na, da) = c.frame_at(a);
+    let (pb, nb, db) = c.frame_at(b);
+    let face_at = |s: f64| {
+        let i = c.points.partition_point(|q| q.s < s).min(c.points.len().saturating_sub(1));
+        c.points.get(i).map_or(NO_FACE, |q| q.face)
+    };
+    let mut pts = vec![PathPoint { p: pa, n: na, d: da, s: a, face: NO_FACE }];
+    let mut on = vec![c.on_surface.get(c.points.partition_point(|q| q.s < a)).copied().unwrap_or(true)];
+    for (q, &o) in c.points.iter().zip(&c.on_surface) {
+        if q.s > a + 1e-9 && q.s < b - 1e-9 {
+            pts.push(*q);
+            on.push(o);
+        }
+    }
+    pts.push(PathPoint { p: pb, n: nb, d: db, s: b, face: face_at(b) });
+    on.push(
+        c.on_surface
+            .get(c.points.partition_point(|q| q.s < b).min(c.points.len().saturating_sub(1)))
+            .copied()
+            .unwrap_or(true),
+    );
+    // Re-base arc length to start at zero.
+    for q in &mut pts {
+        q.s -= a;
+    }
+    for ivs in &mut c.tows {
+        for iv in ivs.iter_mut() {
+            iv[0] -= a;
+            iv[1] -= a;
+        }
+    }
+    c.points = pts;
+    c.on_surface = on;
+}

@@ -1,0 +1,200 @@
+//! Full plies on a flat plate, where the exact answer is known: course count, spacing, coverage,
+//! and tow restart/cut positions under each coverage rule.
+
+use glam::DVec3;
+use towpath_geom::surface::{tessellate_analytic, Analytic, Tessellation};
+use towpath_geom::{BuildOptions, Mesh};
+use towpath_layup::boundary::Region;
+use towpath_layup::field::Rosette;
+use towpath_layup::output::{self, Meta, Post};
+use towpath_layup::ply::{plan, Method, Ply, PlySpec};
+use towpath_layup::section::{Band, Coverage};
+
+fn plate(a: f64, b: f64) -> Mesh {
+    let s = Analytic::parse(&format!("plane:a={a},b={b}")).unwrap();
+    Mesh::build(
+        &tessellate_analytic(&s, &Tessellation::Chord { d_l2s: 0.1, l_seg: 25.0 }).unwrap(),
+        &BuildOptions::default(),
+    )
+    .unwrap()
+    .0
+}
+
+fn run(mesh: &Mesh, region: &Region, angle: f64, tows: usize, coverage: Coverage, start: DVec3, method: Method) -> Ply {
+    let field = Rosette { axis: DVec3::X, angle: angle.to_radians() };
+    let mut spec = PlySpec::new(6.35, tows);
+    spec.coverage = coverage;
+    spec.start = Some(start);
+    spec.method = method;
+    plan(mesh, &field, region, &spec, &mut |_| {}).unwrap()
+}
+
+#[test]
+fn zero_degree_ply_fills_a_plate_of_whole_courses_exactly() {
+    // 12 courses of 8 × 6.35 mm = 50.8 mm fit a 609.6 mm wide plate exactly.
+    let mesh = plate(1000.0, 609.6);
+    let region = Region::whole(&mesh);
+    for method in [Method::Field, Method::Parallel, Method::Natural] {
+        let ply = run(&mesh, &region, 0.0, 8, Coverage::Half, DVec3::new(500.0, 279.4, 0.0), method);
+        assert_eq!(ply.courses.len(), 12, "{method:?}");
+        assert_eq!(ply.n1 + ply.n2 + 1, 12);
+        // Courses 50.8 mm apart, from y = 25.4 to 584.2, each along the full length.
+        for (i, c) in ply.courses.iter().enumerate() {
+            let y = 25.4 + 50.8 * i as f64;
+            let (first, last) = (c.points[0].p.x, c.points[c.points.len() - 1].p.x);
+            assert!(first.abs() < 1e-3 && (last - 1000.0).abs() < 1e-3, "{first} {last}");
+            for p in &c.points {
+                assert!((p.p.y - y).abs() < 1e-6, "{method:?} course {i}: y {} vs {y}", p.p.y);
+            }
+            // Cut positions are found by bisection to 1e-3 mm.
+            assert!((c.length() - 1000.0).abs() < 2e-3, "{}", c.length());
+            for ivs in &c.tows {
+                assert_eq!(ivs.len(), 1);
+                assert!(ivs[0][0].abs() < 1e-3 && (ivs[0][1] - c.length()).abs() < 1e-9, "{ivs:?}");
+            }
+        }
+        let q = &ply.quality;
+        assert!(q.coverage_percent > 99.999, "{method:?} {}", q.coverage_percent);
+        assert!(q.max_gap < 1e-6 && q.max_overlap < 1e-6, "{method:?} {q:?}");
+        assert!(q.max_angle_deviation_deg < 1e-6);
+        assert!(q.min_steering_radius.is_none());
+    }
+}
+
+/// Lateral tow edge positions at arc length s (extended straight beyond the course's ends).
+fn tow_points(c: &towpath_layup::course::Course, band: Band, k: usize, s: f64) -> [DVec3; 3] {
+    let sc = s.clamp(0.0, c.length());
+    let (p, n, d) = c.frame_at(sc);
+    let p = p + d * (s - sc);
+    let b = n.cross(d);
+    [p + b * band.edge(k), p + b * band.centre(k), p + b * band.edge(k + 1)]
+}
+
+#[test]
+fn tows_are_cut_and_restarted_at_the_ply_boundary_under_each_rule() {
+    // A 45° ply inside a square boundary 100..700 on a larger plate: every tow end must sit where
+    // its rule says, checked against the boundary square directly.
+    let mesh = plate(800.0, 800.0);
+    let square = [
+        DVec3::new(100.0, 100.0, 0.0),
+        DVec3::new(700.0, 100.0, 0.0),
+        DVec3::new(700.0, 700.0, 0.0),
+        DVec3::new(100.0, 700.0, 0.0),
+    ];
+    let region = Region::curve(&mesh, &square, 3.0, Some(DVec3::new(400.0, 400.0, 0.0))).unwrap();
+    let inside = |q: DVec3| q.x >= 100.0 - 1e-6 && q.x <= 700.0 + 1e-6 && q.y >= 100.0 - 1e-6 && q.y <= 700.0 + 1e-6;
+    let band = Band { tow_width: 6.35, tows: 8 };
+    let mut coverage_by_rule = Vec::new();
+    for rule in [Coverage::Zero, Coverage::Half, Coverage::Full] {
+        let ply = run(&mesh, &region, 45.0, 8, rule, DVec3::new(400.0, 400.0, 0.0), Method::Field);
+        assert!(ply.courses.len() >= 10);
+        let eps = 0.05;
+        let mut ends = 0;
+        for c in &ply.courses {
+            for (k, ivs) in c.tows.iter().enumerate() {
+                for iv in ivs {
+                    for (s, outward) in [(iv[0], -1.0), (iv[1], 1.0)] {
+                        let at = tow_points(c, band, k, s);
+                        let just_out = tow_points(c, band, k, s + outward * eps);
+                        let just_in = tow_points(c, band, k, s - outward * eps);
+                        match rule {
+                            // All of the tow inside while laid; some part outside just beyond.
+                            Coverage::Zero => {
+                                assert!(
+                                    just_in.iter().all(|&q| inside(q)),
+                                    "{rule:?} course {} tow {k} s {s} {iv:?} at {at:?} in {just_in:?}",
+                                    c.id
+                                );
+                                assert!(
+                                    !just_out.iter().all(|&q| inside(q)),
+                                    "{rule:?} course {} tow {k} s {s} {iv:?} len {} out {just_out:?}",
+                                    c.id,
+                                    c.length()
+                                );
+                            }
+                            Coverage::Half => {
+                                assert!(inside(just_in[1]) && !inside(just_out[1]), "{rule:?}: centre {:?}", at[1]);
+                            }
+                            Coverage::Full => {
+                                assert!(just_in.iter().any(|&q| inside(q)), "{rule:?}");
+                                assert!(!just_out.iter().any(|&q| inside(q)), "{rule:?}");
+                            }
+                        }
+                        ends += 1;
+                    }
+                }
+            }
+        }
+        assert!(ends > 100);
+        coverage_by_rule.push(ply.quality.coverage_percent);
+    }
+    // Less material inside the boundary the earlier tows are cut.
+    assert!(
+        coverage_by_rule[0] < coverage_by_rule[1] && coverage_by_rule[1] < coverage_by_rule[2],
+        "{coverage_by_rule:?}"
+    );
+    assert!(coverage_by_rule[2] > 99.9, "{coverage_by_rule:?}");
+}
+
+#[test]
+fn outputs_carry_the_courses_and_tow_events() {
+    let mesh = plate(400.0, 300.0);
+    let square = [
+        DVec3::new(50.0, 50.0, 0.0),
+        DVec3::new(350.0, 50.0, 0.0),
+        DVec3::new(350.0, 250.0, 0.0),
+        DVec3::new(50.0, 250.0, 0.0),
+    ];
+    let region = Region::curve(&mesh, &square, 3.0, None).unwrap();
+    let ply = run(&mesh, &region, 30.0, 4, Coverage::Half, DVec3::new(200.0, 150.0, 0.0), Method::Field);
+    let meta = Meta {
+        surface: "plane:a=400,b=300".into(),
+        angle_deg: 30.0,
+        direction_source: "axis".into(),
+        tow_width: 6.35,
+        tows: 4,
+        coverage_percent: 50,
+        method: Method::Field,
+        ply_number: 3,
+    };
+    let doc = output::to_json(&ply, &meta);
+    let courses = doc["courses"].as_array().unwrap();
+    assert_eq!(courses.len(), ply.courses.len());
+    assert_eq!(courses[0]["points"].as_array().unwrap().len(), courses[0]["normals"].as_array().unwrap().len());
+    let csv = output::to_csv(&ply);
+    let rows = csv.lines().count() - 1;
+    assert_eq!(rows, ply.courses.iter().map(|c| c.points.len()).sum::<usize>());
+    let g = output::to_gcode(&ply, &meta, &Post::default());
+    assert_eq!(g.matches("(COURSE ").count(), ply.courses.len());
+    assert!(g.contains("(PLY 3 "));
+    // Every tow restarted is cut again, course by course.
+    let mut on = 0u64;
+    for line in g.lines() {
+        if let Some(m) = line.strip_prefix("M60 P") {
+            let m: u64 = m.parse().unwrap();
+            assert_eq!(on & m, 0, "restart of a running tow");
+            on |= m;
+        } else if let Some(m) = line.strip_prefix("M61 P") {
+            let m: u64 = m.parse().unwrap();
+            assert_eq!(on & m, m, "cut of a tow not running");
+            on &= !m;
+        } else if line.starts_with("M21") {
+            assert_eq!(on, 0, "roller lifted with tows running");
+        }
+    }
+    // G1 moves carry all six axis words.
+    assert!(g
+        .lines()
+        .filter(|l| l.starts_with("G1 "))
+        .all(|l| ["X", "Y", "Z", "A", "B", "C"].iter().all(|w| l.contains(w))));
+}
+
+#[test]
+fn abc_angles_rebuild_the_frame() {
+    let n = DVec3::new(0.3, -0.2, 0.9).normalize();
+    let d = n.any_orthonormal_vector();
+    let [a, b, c] = output::abc(n, d).map(f64::to_radians);
+    let r = glam::DMat3::from_rotation_z(c) * glam::DMat3::from_rotation_y(b) * glam::DMat3::from_rotation_x(a);
+    assert!((r.x_axis - d).length() < 1e-12);
+    assert!((r.z_axis - n).length() < 1e-12);
+}

@@ -1,0 +1,417 @@
+//! The machine file: axes, their kinds, weights and limits, and the optional DH chain.
+
+use serde::{Deserialize, Serialize};
+
+use crate::kinematics::Kinematics;
+
+/// What kind of motion an axis makes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AxisKind {
+    /// A prismatic axis, in mm.
+    Linear,
+    /// A rotary axis with a limited range, in degrees: it moves exactly by the programmed change.
+    Rotary,
+    /// A rotary axis that turns without limit, in degrees: moves take the short way round.
+    Continuous,
+    /// The mandrel (the part turns), in degrees: a continuous axis that also defines the part
+    /// frame.
+    Mandrel,
+}
+
+impl AxisKind {
+    /// True for axes measured in degrees.
+    pub fn is_angular(self) -> bool {
+        !matches!(self, AxisKind::Linear)
+    }
+
+    /// True for axes that take the short way round (continuous and mandrel).
+    pub fn wraps(self) -> bool {
+        matches!(self, AxisKind::Continuous | AxisKind::Mandrel)
+    }
+}
+
+fn default_weight() -> f64 {
+    1.0
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// One axis of the machine.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Axis {
+    /// The axis label as written in programs (`X`, `A`, ...).
+    pub label: String,
+    /// The kind of axis.
+    pub kind: AxisKind,
+    /// The cost weight C(a) of seed 000 (default 1).
+    #[serde(default = "default_weight")]
+    pub weight: f64,
+    /// Maximum velocity, mm/s or deg/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_velocity: Option<f64>,
+    /// Maximum acceleration, mm/s² or deg/s².
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_acceleration: Option<f64>,
+    /// True for the axis that turns the head about the tool axis; a reversed course adds 180°.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub heading: bool,
+    /// Lower travel limit (linear and rotary axes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min: Option<f64>,
+    /// Upper travel limit (linear and rotary axes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max: Option<f64>,
+    /// The axis value before the program sets it (default 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub home: f64,
+    /// Mandrel only: the direction of the mandrel's axis of rotation (default `[1, 0, 0]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<[f64; 3]>,
+    /// Mandrel only: a point on the mandrel's axis of rotation (default `[0, 0, 0]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<[f64; 3]>,
+}
+
+impl Axis {
+    /// A new axis with weight 1 and no limits.
+    pub fn new(label: &str, kind: AxisKind) -> Self {
+        Axis {
+            label: label.to_string(),
+            kind,
+            weight: 1.0,
+            max_velocity: None,
+            max_acceleration: None,
+            heading: false,
+            min: None,
+            max: None,
+            home: 0.0,
+            direction: None,
+            origin: None,
+        }
+    }
+}
+
+/// One joint of a Denavit–Hartenberg chain (standard convention:
+/// `Rz(theta) · Tz(d) · Tx(a) · Rx(alpha)`), angles in degrees, lengths in mm.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DhJoint {
+    /// Link length along x.
+    #[serde(default)]
+    pub a: f64,
+    /// Link offset along z.
+    #[serde(default)]
+    pub d: f64,
+    /// Link twist about x, degrees.
+    #[serde(default)]
+    pub alpha: f64,
+    /// Joint angle about z, degrees.
+    #[serde(default)]
+    pub theta: f64,
+    /// The axis that drives this joint: a linear axis adds its value to `d`, an angular axis
+    /// to `theta`. Without one the joint is fixed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<String>,
+}
+
+/// A machine: its axes and, optionally, its kinematics.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Machine {
+    /// The machine's name.
+    pub name: String,
+    /// The axes, in the order states list their values.
+    #[serde(rename = "axis")]
+    pub axes: Vec<Axis>,
+    /// The DH chain from the machine base to the head (optional).
+    #[serde(default, rename = "dh", skip_serializing_if = "Vec::is_empty")]
+    pub dh: Vec<DhJoint>,
+    /// The tool point in the last DH frame (default `[0, 0, 0]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool_offset: Option<[f64; 3]>,
+}
+
+/// Why a machine file was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MachineError {
+    /// The file is not valid TOML or does not have the expected shape.
+    #[error("line {line}: {message}")]
+    Syntax {
+        /// 1-based line of the problem (0 if unknown).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A value is out of range or inconsistent; `key` names it (`axis[2].weight`).
+    #[error("{key}: {message}")]
+    Invalid {
+        /// The key, as a path.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+fn invalid(key: impl Into<String>, message: impl Into<String>) -> MachineError {
+    MachineError::Invalid { key: key.into(), message: message.into() }
+}
+
+impl Machine {
+    /// A machine with the given axes and no kinematics.
+    pub fn new(name: &str, axes: Vec<Axis>) -> Result<Self, MachineError> {
+        let m = Machine { name: name.to_string(), axes, dh: Vec::new(), tool_offset: None };
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// Reads a machine from TOML text and validates it.
+    pub fn from_toml_str(text: &str) -> Result<Self, MachineError> {
+        let m: Machine = toml::from_str(text).map_err(|e| {
+            let line = e.span().map_or(0, |s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+            MachineError::Syntax { line, message: e.message().to_string() }
+        })?;
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// Writes the machine as TOML.
+    pub fn to_toml_string(&self) -> String {
+        // Serializing plain data with finite numbers cannot fail.
+        toml::to_string(self).unwrap_or_default()
+    }
+
+    /// Checks every value; called by the constructors.
+    pub fn validate(&self) -> Result<(), MachineError> {
+        if self.axes.is_empty() {
+            return Err(invalid("axis", "the machine has no axes"));
+        }
+        let mut headings = 0;
+        let mut mandrels = 0;
+        for (i, a) in self.axes.iter().enumerate() {
+            let key = |k: &str| format!("axis[{i}].{k}");
+            if a.label.is_empty() || !a.label.chars().all(|c| c.is_ascii_alphanumeric()) {
+                return Err(invalid(
+                    key("label"),
+                    format!("{:?} is not a valid axis label (letters and digits)", a.label),
+                ));
+            }
+            if let Some(j) = self.axes[..i].iter().position(|b| b.label.eq_ignore_ascii_case(&a.label)) {
+                return Err(invalid(key("label"), format!("axis {:?} is defined twice (also axis[{j}])", a.label)));
+            }
+            if !(a.weight.is_finite() && a.weight >= 0.0) {
+                return Err(invalid(key("weight"), format!("{} is not a finite weight ≥ 0", a.weight)));
+            }
+            for (k, v) in [("max_velocity", a.max_velocity), ("max_acceleration", a.max_acceleration)] {
+                if let Some(v) = v {
+                    if !(v.is_finite() && v > 0.0) {
+                        return Err(invalid(key(k), format!("{v} is not a finite value > 0")));
+                    }
+                }
+            }
+            if !a.home.is_finite() {
+                return Err(invalid(key("home"), "not a finite number"));
+            }
+            for (k, v) in [("min", a.min), ("max", a.max)] {
+                if let Some(v) = v {
+                    if !v.is_finite() {
+                        return Err(invalid(key(k), "not a finite number"));
+                    }
+                    if a.kind.wraps() {
+                        return Err(invalid(key(k), "continuous and mandrel axes have no travel limits"));
+                    }
+                }
+            }
+            if let (Some(lo), Some(hi)) = (a.min, a.max) {
+                if lo > hi {
+                    return Err(invalid(key("min"), format!("min {lo} is above max {hi}")));
+                }
+            }
+            if a.heading {
+                headings += 1;
+                if !matches!(a.kind, AxisKind::Rotary | AxisKind::Continuous) {
+                    return Err(invalid(key("heading"), "the heading axis must be rotary or continuous"));
+                }
+                if headings > 1 {
+                    return Err(invalid(key("heading"), "only one axis can be the heading axis"));
+                }
+            }
+            if a.kind == AxisKind::Mandrel {
+                mandrels += 1;
+                if mandrels > 1 {
+                    return Err(invalid(key("kind"), "only one axis can be the mandrel"));
+                }
+            } else if a.direction.is_some() || a.origin.is_some() {
+                return Err(invalid(key("direction"), "direction and origin are for the mandrel axis only"));
+            }
+            if let Some(d) = a.direction {
+                let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                if !(n.is_finite() && n > 1e-12) {
+                    return Err(invalid(key("direction"), "the mandrel direction must be a finite non-zero vector"));
+                }
+            }
+            if let Some(o) = a.origin {
+                if !o.iter().all(|v| v.is_finite()) {
+                    return Err(invalid(key("origin"), "not finite"));
+                }
+            }
+        }
+        let mut driven = vec![false; self.axes.len()];
+        for (j, joint) in self.dh.iter().enumerate() {
+            let key = |k: &str| format!("dh[{j}].{k}");
+            for (k, v) in [("a", joint.a), ("d", joint.d), ("alpha", joint.alpha), ("theta", joint.theta)] {
+                if !v.is_finite() {
+                    return Err(invalid(key(k), "not a finite number"));
+                }
+            }
+            if let Some(label) = &joint.axis {
+                let Some(i) = self.axis_index(label) else {
+                    return Err(invalid(key("axis"), format!("no axis is labelled {label:?}")));
+                };
+                if self.axes[i].kind == AxisKind::Mandrel {
+                    return Err(invalid(
+                        key("axis"),
+                        "the mandrel turns the part, not the head: leave it out of the chain",
+                    ));
+                }
+                if driven[i] {
+                    return Err(invalid(key("axis"), format!("axis {label:?} drives two joints")));
+                }
+                driven[i] = true;
+            }
+        }
+        if let Some(t) = self.tool_offset {
+            if !t.iter().all(|v| v.is_finite()) {
+                return Err(invalid("tool_offset", "not finite"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of axes (the length of a state).
+    pub fn dim(&self) -> usize {
+        self.axes.len()
+    }
+
+    /// Index of the axis with this label (case-insensitive).
+    pub fn axis_index(&self, label: &str) -> Option<usize> {
+        self.axes.iter().position(|a| a.label.eq_ignore_ascii_case(label))
+    }
+
+    /// Index of the heading axis, if any.
+    pub fn heading_axis(&self) -> Option<usize> {
+        self.axes.iter().position(|a| a.heading)
+    }
+
+    /// Index of the mandrel axis, if any.
+    pub fn mandrel_axis(&self) -> Option<usize> {
+        self.axes.iter().position(|a| a.kind == AxisKind::Mandrel)
+    }
+
+    /// The home state: every axis at its `home` value.
+    pub fn home(&self) -> Vec<f64> {
+        self.axes.iter().map(|a| a.home).collect()
+    }
+
+    /// The travel of axis `i` on a move from `from` to `to`: the plain difference, or for
+    /// continuous and mandrel axes the short way round, in (−180, 180].
+    #[inline]
+    pub fn short_delta(&self, i: usize, from: f64, to: f64) -> f64 {
+        let d = to - from;
+        if self.axes[i].kind.wraps() {
+            wrap_degrees(d)
+        } else {
+            d
+        }
+    }
+
+    /// Forward kinematics, if the machine has any (a DH chain, or X/Y/Z linear axes).
+    pub fn kinematics(&self) -> Option<Kinematics> {
+        Kinematics::new(self)
+    }
+}
+
+/// Wraps an angle in degrees to (−180, 180].
+#[inline]
+pub(crate) fn wrap_degrees(d: f64) -> f64 {
+    let r = d - 360.0 * (d / 360.0).round();
+    if r <= -180.0 {
+        r + 360.0
+    } else if r > 180.0 {
+        r - 360.0
+    } else {
+        r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GANTRY: &str = r#"
+name = "gantry-afp"
+[[axis]]
+label = "X"
+kind = "linear"
+weight = 1.0
+max_velocity = 1000.0
+max_acceleration = 2000.0
+[[axis]]
+label = "C"
+kind = "continuous"
+heading = true
+"#;
+
+    #[test]
+    fn reads_the_documented_shape() {
+        let m = Machine::from_toml_str(GANTRY).unwrap();
+        assert_eq!(m.name, "gantry-afp");
+        assert_eq!(m.dim(), 2);
+        assert_eq!(m.axes[0].max_velocity, Some(1000.0));
+        assert_eq!(m.axes[1].weight, 1.0);
+        assert_eq!(m.heading_axis(), Some(1));
+        assert_eq!(m.axis_index("c"), Some(1));
+        let again = Machine::from_toml_str(&m.to_toml_string()).unwrap();
+        assert_eq!(again, m);
+    }
+
+    #[test]
+    fn refuses_bad_files_with_the_key_or_line() {
+        let e = Machine::from_toml_str("name = \"m\"\n[[axis]]\nlabel = \"X\"\nkind = \"lineer\"\n").unwrap_err();
+        assert!(matches!(e, MachineError::Syntax { line: 4, .. }), "{e}");
+        let e = Machine::from_toml_str("name = \"m\"\n[[axis]]\nlabel = \"X\"\nkind = \"linear\"\nwieght = 2\n")
+            .unwrap_err();
+        assert!(matches!(e, MachineError::Syntax { line: 5, .. }), "{e}");
+        let e = Machine::from_toml_str(&GANTRY.replace("weight = 1.0", "weight = -1.0")).unwrap_err();
+        assert_eq!(e.to_string(), "axis[0].weight: -1 is not a finite weight ≥ 0");
+        let e = Machine::from_toml_str(&GANTRY.replace("\"C\"", "\"x\"")).unwrap_err();
+        assert!(e.to_string().contains("defined twice"), "{e}");
+        let e = Machine::from_toml_str(&GANTRY.replace("kind = \"continuous\"", "kind = \"linear\"")).unwrap_err();
+        assert!(e.to_string().contains("heading axis must be rotary"), "{e}");
+        let e = Machine::from_toml_str(&format!("{GANTRY}[[dh]]\naxis = \"Q\"\n")).unwrap_err();
+        assert!(e.to_string().starts_with("dh[0].axis"), "{e}");
+        let e = Machine::from_toml_str("name = \"m\"\naxis = []\n").unwrap_err();
+        assert!(e.to_string().contains("no axes"), "{e}");
+        let e = Machine::from_toml_str(&GANTRY.replace("max_velocity = 1000.0", "max_velocity = nan")).unwrap_err();
+        assert!(e.to_string().contains("max_velocity"), "{e}");
+    }
+
+    #[test]
+    fn short_way_round() {
+        assert_eq!(wrap_degrees(350.0), -10.0);
+        assert_eq!(wrap_degrees(-350.0), 10.0);
+        assert_eq!(wrap_degrees(180.0), 180.0);
+        assert_eq!(wrap_degrees(-180.0), 180.0);
+        assert_eq!(wrap_degrees(720.5), 0.5);
+        let m = Machine::from_toml_str(GANTRY).unwrap();
+        assert_eq!(m.short_delta(1, 350.0, 10.0), 20.0);
+        assert_eq!(m.short_delta(0, 350.0, 10.0), -340.0);
+    }
+}

@@ -1,0 +1,278 @@
+//! Program dialects: which words and markers mean what. `docs/dialect.md` documents every key;
+//! [`Dialect::default`] is the reference dialect (ISO G-code, `G0`/`G1`, `M20`/`M21` roller
+//! contact, `M60`/`M61 P<mask>` tow restart/cut, `(PLY n)` and `(COURSE n)` comments).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::NcError;
+
+/// A word code such as `G1` or `M60`: a letter and a number (`G01` equals `G1`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Code {
+    /// The letter, upper case.
+    pub letter: char,
+    /// The number.
+    pub number: f64,
+}
+
+impl Code {
+    /// Parses `"G1"`, `"m60"`, `"G64.1"`. Returns `None` for anything else.
+    pub fn parse(text: &str) -> Option<Code> {
+        let text = text.trim();
+        let mut chars = text.chars();
+        let letter = chars.next()?.to_ascii_uppercase();
+        if !letter.is_ascii_alphabetic() {
+            return None;
+        }
+        let rest = chars.as_str();
+        if rest.is_empty() || !rest.chars().all(|c| c.is_ascii_digit() || c == '.') {
+            return None;
+        }
+        let number: f64 = rest.parse().ok()?;
+        Some(Code { letter, number })
+    }
+
+    /// True if a word (letter, value) is this code.
+    #[inline]
+    pub fn matches(&self, letter: char, value: f64) -> bool {
+        self.letter == letter && self.number == value
+    }
+}
+
+impl std::fmt::Display for Code {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}{}", self.letter, self.number)
+    }
+}
+
+/// Where tow and contact codes written on a motion line take effect.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EventTiming {
+    /// At the start of the line's move.
+    Before,
+    /// At the end of the line's move (default).
+    After,
+}
+
+fn s(x: &str) -> String {
+    x.to_string()
+}
+
+/// A program dialect, read from TOML. Every key has a default: the reference dialect.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Dialect {
+    /// Codes of rapid moves.
+    pub rapid: Vec<String>,
+    /// Codes of feed (linear interpolation) moves.
+    pub feed: Vec<String>,
+    /// Absolute distance mode.
+    pub absolute: String,
+    /// Incremental distance mode.
+    pub incremental: String,
+    /// Set-position code (`G92 A10` declares the current position to be A10). towpath also
+    /// writes it to unwind continuous axes after a short-way move.
+    pub set_position: String,
+    /// The feed-rate word letter.
+    pub feed_word: String,
+    /// The line-number word letter (numbers are kept on the lines that have them).
+    pub line_number_word: String,
+    /// Roller contact on; empty when the machine has no contact codes (courses then run from
+    /// the first tow restart to the cut of the last tow).
+    pub contact_on: String,
+    /// Roller contact off (lift).
+    pub contact_off: String,
+    /// Tow restart (add) code; its mask word gives the tows as a bit set.
+    pub tow_restart: String,
+    /// Tow cut code.
+    pub tow_cut: String,
+    /// The word carrying the tow mask on restart/cut lines.
+    pub tow_mask_word: String,
+    /// Comment prefix marking the start of a ply (`(PLY 3 ...)`).
+    pub ply_comment: String,
+    /// Comment prefix marking the start of a course (`(COURSE 12 ...)`); optional in programs.
+    pub course_comment: String,
+    /// Comments in parentheses.
+    pub comment_parens: bool,
+    /// Comments from `;` to the end of the line.
+    pub comment_semicolon: bool,
+    /// How many motion lines before roller contact form a course's approach block (kept with
+    /// the course); earlier off-part motion is transit and is regenerated.
+    pub approach_moves: usize,
+    /// How many motion lines after the lift form a course's retract block.
+    pub retract_moves: usize,
+    /// True if the controller itself takes continuous axes the short way round (rotary
+    /// roll-over); false if it moves by the literal difference of programmed values.
+    pub rollover: bool,
+    /// Where tow and contact codes written on a motion line take effect.
+    pub event_timing: EventTiming,
+    /// Tow width in mm (course width = tow width × tows on), if not given on the command line.
+    pub tow_width: Option<f64>,
+    /// Course width in mm, if not given on the command line.
+    pub course_width: Option<f64>,
+    /// Digits after the decimal point in numbers towpath writes.
+    pub decimals: usize,
+    /// G codes whose axis words are not positions (a dwell `G4 X2`): such lines are kept as
+    /// they are and move nothing.
+    pub non_motion_codes: Vec<String>,
+}
+
+impl Default for Dialect {
+    fn default() -> Self {
+        Dialect {
+            rapid: vec![s("G0")],
+            feed: vec![s("G1")],
+            absolute: s("G90"),
+            incremental: s("G91"),
+            set_position: s("G92"),
+            feed_word: s("F"),
+            line_number_word: s("N"),
+            contact_on: s("M20"),
+            contact_off: s("M21"),
+            tow_restart: s("M60"),
+            tow_cut: s("M61"),
+            tow_mask_word: s("P"),
+            ply_comment: s("PLY"),
+            course_comment: s("COURSE"),
+            comment_parens: true,
+            comment_semicolon: true,
+            approach_moves: 1,
+            retract_moves: 1,
+            rollover: false,
+            event_timing: EventTiming::After,
+            tow_width: None,
+            course_width: None,
+            decimals: 4,
+            non_motion_codes: vec![s("G4")],
+        }
+    }
+}
+
+/// A dialect with its codes parsed, ready for the parser.
+#[derive(Clone, Debug)]
+pub(crate) struct Codes {
+    pub rapid: Vec<Code>,
+    pub feed: Vec<Code>,
+    pub absolute: Code,
+    pub incremental: Code,
+    pub set_position: Code,
+    pub feed_word: char,
+    pub line_number_word: char,
+    pub contact: Option<(Code, Code)>,
+    pub restart: Code,
+    pub cut: Code,
+    pub mask_word: char,
+}
+
+impl Dialect {
+    /// Reads a dialect from TOML text (missing keys take the reference values).
+    pub fn from_toml_str(text: &str) -> Result<Self, NcError> {
+        let d: Dialect = toml::from_str(text).map_err(|e| {
+            let line = e.span().map_or(0, |s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+            NcError::Dialect(format!("line {line}: {}", e.message()))
+        })?;
+        d.codes()?;
+        Ok(d)
+    }
+
+    /// Writes the dialect as TOML.
+    pub fn to_toml_string(&self) -> String {
+        toml::to_string(self).unwrap_or_default()
+    }
+
+    /// Parses and checks the codes.
+    pub(crate) fn codes(&self) -> Result<Codes, NcError> {
+        let code = |key: &str, v: &str| {
+            Code::parse(v).ok_or_else(|| NcError::Dialect(format!("{key}: {v:?} is not a code like G1 or M60")))
+        };
+        let letter = |key: &str, v: &str| {
+            let mut c = v.chars();
+            match (c.next(), c.next()) {
+                (Some(l), None) if l.is_ascii_alphabetic() => Ok(l.to_ascii_uppercase()),
+                _ => Err(NcError::Dialect(format!("{key}: {v:?} is not a single letter"))),
+            }
+        };
+        let list = |key: &str, v: &[String]| -> Result<Vec<Code>, NcError> {
+            if v.is_empty() {
+                return Err(NcError::Dialect(format!("{key}: at least one code is needed")));
+            }
+            v.iter().map(|x| code(key, x)).collect()
+        };
+        let contact = match (self.contact_on.trim().is_empty(), self.contact_off.trim().is_empty()) {
+            (true, true) => None,
+            (false, false) => Some((code("contact_on", &self.contact_on)?, code("contact_off", &self.contact_off)?)),
+            _ => return Err(NcError::Dialect("contact_on and contact_off must both be set or both be empty".into())),
+        };
+        for (k, w) in [("tow_width", self.tow_width), ("course_width", self.course_width)] {
+            if let Some(w) = w {
+                if !(w.is_finite() && w > 0.0) {
+                    return Err(NcError::Dialect(format!("{k}: {w} is not a width > 0")));
+                }
+            }
+        }
+        if self.decimals > 9 {
+            return Err(NcError::Dialect(format!("decimals: {} is more than 9", self.decimals)));
+        }
+        if !self.comment_parens && !self.comment_semicolon {
+            return Err(NcError::Dialect(
+                "comments: enable comment_parens or comment_semicolon (markers are comments)".into(),
+            ));
+        }
+        if self.ply_comment.trim().is_empty() {
+            return Err(NcError::Dialect("ply_comment: must not be empty".into()));
+        }
+        Ok(Codes {
+            rapid: list("rapid", &self.rapid)?,
+            feed: list("feed", &self.feed)?,
+            absolute: code("absolute", &self.absolute)?,
+            incremental: code("incremental", &self.incremental)?,
+            set_position: code("set_position", &self.set_position)?,
+            feed_word: letter("feed_word", &self.feed_word)?,
+            line_number_word: letter("line_number_word", &self.line_number_word)?,
+            contact,
+            restart: code("tow_restart", &self.tow_restart)?,
+            cut: code("tow_cut", &self.tow_cut)?,
+            mask_word: letter("tow_mask_word", &self.tow_mask_word)?,
+        })
+    }
+
+    /// Writes a comment in this dialect's style.
+    pub fn comment(&self, text: &str) -> String {
+        if self.comment_parens {
+            format!("({})", text.replace(['(', ')'], ""))
+        } else {
+            format!(";{text}")
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codes_compare_numerically() {
+        let c = Code::parse("G01").unwrap();
+        assert!(c.matches('G', 1.0));
+        assert!(Code::parse("g64.1").unwrap().matches('G', 64.1));
+        assert!(Code::parse("X").is_none());
+        assert!(Code::parse("1G").is_none());
+    }
+
+    #[test]
+    fn reference_dialect_round_trips_and_bad_keys_are_named() {
+        let d = Dialect::default();
+        assert_eq!(Dialect::from_toml_str(&d.to_toml_string()).unwrap(), d);
+        let d = Dialect::from_toml_str("contact_on = \"\"\ncontact_off = \"\"\n").unwrap();
+        assert!(d.codes().unwrap().contact.is_none());
+        let e = Dialect::from_toml_str("rapid = [\"Q\"]").unwrap_err();
+        assert!(e.to_string().contains("rapid"), "{e}");
+        let e = Dialect::from_toml_str("\nrapidd = [\"G0\"]").unwrap_err();
+        assert!(e.to_string().contains("line 2"), "{e}");
+        let e = Dialect::from_toml_str("contact_on = \"\"").unwrap_err();
+        assert!(e.to_string().contains("both"), "{e}");
+        let e = Dialect::from_toml_str("tow_width = -3.0").unwrap_err();
+        assert!(e.to_string().contains("tow_width"), "{e}");
+    }
+}

@@ -1,0 +1,370 @@
+//! Course footprints: the on-part path swept by the course width, in a 2D frame of the part.
+//!
+//! The frame is the plan view (x, y of the part-frame tool point) for machines without a
+//! mandrel, and the unrolled cylinder (axial position, arc length at a reference radius) for
+//! machines with one; the unrolled frame is periodic in its second coordinate. Each laid move
+//! becomes one or more rectangles ([`Quad`]) of the course width at that move: the tow width
+//! times the tows on (dropped tows narrow it) or a fixed course width.
+//!
+//! Two footprints *overlap* when they share a region wider than [`OVERLAP_TOLERANCE`]: every
+//! rectangle is shrunk by half that tolerance on each side, and shrunk rectangles must overlap
+//! with positive area (bands that only touch do not overlap).
+
+use towpath_machine::{Kinematics, Machine};
+
+use crate::error::NcError;
+use crate::program::Program;
+
+/// Overlaps narrower than this (mm) do not count.
+pub const OVERLAP_TOLERANCE: f64 = 0.01;
+
+/// How wide a course is.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum Width {
+    /// Tow width in mm: the course width is this times the number of tows on.
+    Tow(f64),
+    /// A fixed course width in mm.
+    Course(f64),
+}
+
+/// The 2D frame footprints are drawn in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Frame {
+    /// Plan view: x and y of the part-frame tool point.
+    Plan,
+    /// Unrolled cylinder around the mandrel axis: (axial, arc length at `radius`), periodic in
+    /// the second coordinate with period 2π·radius.
+    Cylinder {
+        /// A point on the axis.
+        origin: [f64; 3],
+        /// Unit direction of the axis.
+        dir: [f64; 3],
+        /// First unit vector across the axis (angle 0).
+        e1: [f64; 3],
+        /// Second unit vector across the axis (angle 90°).
+        e2: [f64; 3],
+        /// Reference radius, mm.
+        radius: f64,
+    },
+}
+
+impl Frame {
+    /// The period of the second coordinate, if the frame is periodic.
+    pub fn period(&self) -> Option<f64> {
+        match self {
+            Frame::Plan => None,
+            Frame::Cylinder { radius, .. } => Some(2.0 * std::f64::consts::PI * radius),
+        }
+    }
+
+    /// Maps a part-frame point to the frame (unwrapped angle in (−π, π]).
+    pub fn map(&self, p: [f64; 3]) -> [f64; 2] {
+        match self {
+            Frame::Plan => [p[0], p[1]],
+            Frame::Cylinder { origin, dir, e1, e2, radius } => {
+                let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
+                let u = dot(d, *dir);
+                let phi = dot(d, *e2).atan2(dot(d, *e1));
+                [u, radius * phi]
+            }
+        }
+    }
+
+    /// Moves `v` by whole periods to be as close as possible to `near`.
+    #[inline]
+    pub fn unwrap_near(&self, v: f64, near: f64) -> f64 {
+        match self.period() {
+            None => v,
+            Some(p) => v - p * ((v - near) / p).round(),
+        }
+    }
+}
+
+/// An oriented rectangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quad {
+    /// Centre.
+    pub c: [f64; 2],
+    /// Unit vector along the rectangle.
+    pub u: [f64; 2],
+    /// Half length along `u`.
+    pub hl: f64,
+    /// Half width across `u`.
+    pub hw: f64,
+}
+
+impl Quad {
+    /// The four corners, counter-clockwise.
+    pub fn corners(&self) -> [[f64; 2]; 4] {
+        let n = [-self.u[1], self.u[0]];
+        let (a, b) = ([self.u[0] * self.hl, self.u[1] * self.hl], [n[0] * self.hw, n[1] * self.hw]);
+        [
+            [self.c[0] - a[0] - b[0], self.c[1] - a[1] - b[1]],
+            [self.c[0] + a[0] - b[0], self.c[1] + a[1] - b[1]],
+            [self.c[0] + a[0] + b[0], self.c[1] + a[1] + b[1]],
+            [self.c[0] - a[0] + b[0], self.c[1] - a[1] + b[1]],
+        ]
+    }
+
+    /// Axis-aligned bounds (min, max).
+    pub fn bounds(&self) -> ([f64; 2], [f64; 2]) {
+        let ex = self.hl * self.u[0].abs() + self.hw * self.u[1].abs();
+        let ey = self.hl * self.u[1].abs() + self.hw * self.u[0].abs();
+        ([self.c[0] - ex, self.c[1] - ey], [self.c[0] + ex, self.c[1] + ey])
+    }
+
+    /// The same rectangle moved along the second coordinate.
+    pub fn shifted(&self, dv: f64) -> Quad {
+        Quad { c: [self.c[0], self.c[1] + dv], ..*self }
+    }
+
+    /// True if the interiors of the two rectangles intersect (touching is not enough).
+    pub fn overlaps(&self, o: &Quad) -> bool {
+        let d = [o.c[0] - self.c[0], o.c[1] - self.c[1]];
+        let axes = [self.u, [-self.u[1], self.u[0]], o.u, [-o.u[1], o.u[0]]];
+        for l in axes {
+            let dist = (d[0] * l[0] + d[1] * l[1]).abs();
+            if dist >= self.radius(l) + o.radius(l) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// True if the point lies in the closed rectangle.
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        let d = [p[0] - self.c[0], p[1] - self.c[1]];
+        let along = (d[0] * self.u[0] + d[1] * self.u[1]).abs();
+        let across = (-d[0] * self.u[1] + d[1] * self.u[0]).abs();
+        along <= self.hl && across <= self.hw
+    }
+
+    #[inline]
+    fn radius(&self, l: [f64; 2]) -> f64 {
+        self.hl * (self.u[0] * l[0] + self.u[1] * l[1]).abs() + self.hw * (-self.u[1] * l[0] + self.u[0] * l[1]).abs()
+    }
+}
+
+/// A course's footprint.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Footprint {
+    /// The shrunk rectangles (see the module docs), unwrapped along the course: each laid move
+    /// split into pieces no longer than four widths.
+    pub quads: Vec<Quad>,
+    /// The whole shrunk rectangle of each laid move (the union of its pieces).
+    pub moves: Vec<Quad>,
+    /// For each piece, its move.
+    pub move_of: Vec<u32>,
+    /// The laid centre line as polylines in the frame (unwrapped along the course).
+    pub paths: Vec<Vec<[f64; 2]>>,
+}
+
+impl Footprint {
+    /// True if the two footprints overlap (see the module docs).
+    pub fn overlaps(&self, other: &Footprint, frame: &Frame) -> bool {
+        for a in &self.quads {
+            let (amin, amax) = a.bounds();
+            for b in &other.quads {
+                let b = match frame.period() {
+                    Some(_) => b.shifted(frame.unwrap_near(b.c[1], a.c[1]) - b.c[1]),
+                    None => *b,
+                };
+                let (bmin, bmax) = b.bounds();
+                if bmin[0] >= amax[0] || bmax[0] <= amin[0] || bmin[1] >= amax[1] || bmax[1] <= amin[1] {
+                    continue;
+                }
+                if a.overlaps(&b) {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+/// The footprints of every course of a program.
+#[derive(Clone, Debug)]
+pub struct Footprints {
+    /// The frame.
+    pub frame: Frame,
+    /// One footprint per course.
+    pub courses: Vec<Footprint>,
+}
+
+/// The part-frame frame for a machine and program: plan, or an unrolled cylinder around the
+/// mandrel at the median radius of the laid points.
+pub fn frame_for(program: &Program, machine: &Machine, kin: &Kinematics) -> Frame {
+    let Some((origin, dir)) = kin.mandrel_axis() else {
+        return Frame::Plan;
+    };
+    // e1: any unit vector across the axis.
+    let pick = if dir[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+    let e1 = normalize(sub(pick, scale(dir, dot(pick, dir))));
+    let e2 = cross(dir, e1);
+    let mut radii: Vec<f64> = program
+        .segments
+        .iter()
+        .filter(|s| s.on_part)
+        .map(|s| {
+            let p = kin.part_point(program.point(s.to));
+            let d = sub(p, origin);
+            let r = sub(d, scale(dir, dot(d, dir)));
+            dot(r, r).sqrt()
+        })
+        .filter(|r| r.is_finite())
+        .collect();
+    radii.sort_by(f64::total_cmp);
+    let radius = radii.get(radii.len() / 2).copied().filter(|r| *r > 1e-6).unwrap_or(1.0);
+    let _ = machine;
+    Frame::Cylinder { origin, dir, e1, e2, radius }
+}
+
+/// Builds the footprints of every course. Needs the machine's kinematics and a width.
+pub fn footprints(program: &Program, machine: &Machine, width: Width) -> Result<Footprints, NcError> {
+    let kin = machine.kinematics().ok_or_else(|| {
+        NcError::Machine(
+            "course footprints need the tool point: give the machine a DH chain or X/Y/Z linear axes \
+             (or use --precedence plies, which needs no footprints)"
+                .into(),
+        )
+    })?;
+    let frame = frame_for(program, machine, &kin);
+    let mut courses = Vec::with_capacity(program.courses.len());
+    for (c, course) in program.courses.iter().enumerate() {
+        let segs = &program.segments[course.segments.clone()];
+        let has_tows = segs.iter().any(|s| s.on_part && s.mask != 0);
+        if !has_tows && matches!(width, Width::Tow(_)) && segs.iter().any(|s| s.on_part) {
+            return Err(NcError::Width(format!(
+                "line {}: this course restarts no tows, so a tow width cannot give its width: use --course-width",
+                course.on_part.start + 1
+            )));
+        }
+        let mut fp = Footprint::default();
+        let mut path: Vec<[f64; 2]> = Vec::new();
+        let mut last_v: Option<f64> = None;
+        for s in segs {
+            let laid = s.on_part && (!has_tows || s.mask != 0);
+            if !laid {
+                if path.len() > 1 {
+                    fp.paths.push(std::mem::take(&mut path));
+                }
+                path.clear();
+                continue;
+            }
+            let w = match width {
+                Width::Course(w) => w,
+                Width::Tow(t) => t * s.mask.count_ones() as f64,
+            };
+            let mut a = frame.map(kin.part_point(program.point(s.from)));
+            let mut b = frame.map(kin.part_point(program.point(s.to)));
+            if let Some(v) = last_v {
+                a[1] = frame.unwrap_near(a[1], v);
+            }
+            b[1] = frame.unwrap_near(b[1], a[1]);
+            last_v = Some(b[1]);
+            if path.is_empty() {
+                path.push(a);
+            }
+            path.push(b);
+            add_quads(&mut fp, a, b, w);
+        }
+        if path.len() > 1 {
+            fp.paths.push(path);
+        }
+        let _ = c;
+        courses.push(fp);
+    }
+    Ok(Footprints { frame, courses })
+}
+
+/// Adds the shrunk rectangles of one laid move from `a` to `b` of width `w`, split into pieces
+/// no longer than four widths (so spatial indexes stay tight).
+fn add_quads(fp: &mut Footprint, a: [f64; 2], b: [f64; 2], w: f64) {
+    let shrink = OVERLAP_TOLERANCE / 2.0;
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
+    let hw = w / 2.0 - shrink;
+    if !(len > OVERLAP_TOLERANCE && hw > 0.0 && len.is_finite()) {
+        return;
+    }
+    let u = [d[0] / len, d[1] / len];
+    let inner = len - OVERLAP_TOLERANCE;
+    let pieces = ((inner / (4.0 * w.max(1e-3))).ceil() as usize).clamp(1, 100_000);
+    let piece = inner / pieces as f64;
+    let m = fp.moves.len() as u32;
+    fp.moves.push(Quad { c: [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0], u, hl: inner / 2.0, hw });
+    for k in 0..pieces {
+        let t = shrink + piece * (k as f64 + 0.5);
+        fp.quads.push(Quad { c: [a[0] + u[0] * t, a[1] + u[1] * t], u, hl: piece / 2.0, hw });
+        fp.move_of.push(m);
+    }
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+fn normalize(a: [f64; 3]) -> [f64; 3] {
+    let n = dot(a, a).sqrt();
+    [a[0] / n, a[1] / n, a[2] / n]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn band(x0: f64, y: f64, x1: f64, w: f64) -> Footprint {
+        let mut fp = Footprint::default();
+        add_quads(&mut fp, [x0, y], [x1, y], w);
+        fp
+    }
+
+    #[test]
+    fn bands_that_touch_do_not_overlap_and_wider_overlaps_do() {
+        let f = Frame::Plan;
+        let a = band(0.0, 0.0, 100.0, 10.0);
+        // Side by side, edges touching: y = 10 apart with width 10.
+        assert!(!a.overlaps(&band(0.0, 10.0, 100.0, 10.0), &f));
+        // Overlapping by 0.005 mm: below the tolerance.
+        assert!(!a.overlaps(&band(0.0, 9.995, 100.0, 10.0), &f));
+        // Overlapping by 0.02 mm: counts.
+        assert!(a.overlaps(&band(0.0, 9.98, 100.0, 10.0), &f));
+        // End to end, touching.
+        assert!(!a.overlaps(&band(100.0, 0.0, 200.0, 10.0), &f));
+        // Crossing at right angles.
+        let mut cross = Footprint::default();
+        add_quads(&mut cross, [50.0, -50.0], [50.0, 50.0], 10.0);
+        assert!(a.overlaps(&cross, &f));
+        // Long moves are split into short pieces.
+        assert_eq!(a.quads.len(), 3);
+        assert_eq!(a.moves.len(), 1);
+        assert_eq!(a.move_of, vec![0, 0, 0]);
+    }
+
+    #[test]
+    fn periodic_frame_wraps() {
+        let f = Frame::Cylinder {
+            origin: [0.0; 3],
+            dir: [1.0, 0.0, 0.0],
+            e1: [0.0, 1.0, 0.0],
+            e2: [0.0, 0.0, 1.0],
+            radius: 100.0,
+        };
+        let p = f.period().unwrap();
+        // Two hoop bands at the same axial place, one written one turn further.
+        let a = band(0.0, 5.0, 50.0, 10.0);
+        let mut b = band(0.0, 5.0 + p, 50.0, 10.0);
+        assert!(a.overlaps(&b, &f));
+        b = band(0.0, 20.0 + p, 50.0, 10.0);
+        assert!(!a.overlaps(&b, &f));
+        assert!((f.map([3.0, 0.0, 100.0])[1] - p / 4.0).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,40 @@
+//! # towpath-nc: AFP programs
+//!
+//! Reads a qualified AFP program in a configurable [`Dialect`] into a [`Program`] (plies →
+//! courses with approach, on-part and retract blocks), builds the sequencing problem of its
+//! courses for a [`towpath_machine::Machine`] (course footprints, precedence, optional reversal),
+//! and writes the program back in a new order with only the off-part motion regenerated. An
+//! independent [`verify`] checks an optimized program against its original.
+
+#![warn(missing_docs)]
+
+pub mod demo;
+mod dialect;
+mod error;
+mod footprint;
+mod interp;
+mod lex;
+mod optimize;
+mod parse;
+mod precedence;
+mod problem;
+mod program;
+mod report;
+mod reverse;
+mod rewrite;
+mod verify;
+
+pub use dialect::{Code, Dialect, EventTiming};
+pub use error::NcError;
+pub use footprint::{footprints, Footprint, Footprints, Frame, Quad, Width, OVERLAP_TOLERANCE};
+pub use interp::{Event, Interp, Marker, Modal};
+pub use lex::{lex, LexIssue, Lexed, NumText, Word};
+pub use optimize::{apply_steps, auto_time_limit, optimize, OptimizeOptions, Optimized, SolverSummary, Timings};
+pub use parse::parse;
+pub use precedence::{course_precedence, precedence_sets};
+pub use problem::{build_problem, placements, AfpOptions, AfpProblem, PrecedenceRule};
+pub use program::{ply_name, Course, Item, Ply, Program, Region, Segment};
+pub use report::{totals, GroupCost, GroupRow, OrderRow, Report, Totals};
+pub use reverse::{reversal_of, reverse_course, Reversed};
+pub use rewrite::{rewrite, Placement};
+pub use verify::{measure, verify, verify_parsed, Motion, Verification, VerifyError, VerifyOptions};

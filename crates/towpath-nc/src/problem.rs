@@ -1,0 +1,278 @@
+//! The sequencing problem of a program's courses, for `towpath_seq` (or any other solver).
+//!
+//! Each course is a task. Its forward mode enters at the state where the original program's
+//! transit into it ended and leaves at the end of its retract block; its reverse mode (when
+//! bidirectional layup is allowed and the course can be reversed) enters at the end of the
+//! retract block turned round and leaves at the start of the approach turned round. A mode's
+//! own cost is its approach and retract motion, so the route cost is the off-part motion of
+//! the courses. The route starts at the end of the header and ends free, or at the footer's end
+//! state when the footer writes every axis.
+
+use towpath_machine::{CostKind, Machine, MachineCost, StateTable};
+use towpath_seq::{End, Mode, Problem, Step, TaskId};
+
+use crate::dialect::Dialect;
+use crate::error::NcError;
+use crate::footprint::{footprints, Footprints, Width};
+use crate::interp::Interp;
+use crate::precedence::{course_precedence, precedence_sets};
+use crate::program::Program;
+use crate::reverse::{reversal_of, Reversed};
+
+/// Which precedence to impose.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum PrecedenceRule {
+    /// A course after every course of an earlier ply it overlaps (default).
+    #[default]
+    Courses,
+    /// Seed 000's precedence sets: each set after the one before.
+    Sets,
+    /// Every ply after the one before.
+    Plies,
+}
+
+impl std::str::FromStr for PrecedenceRule {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "courses" => Ok(PrecedenceRule::Courses),
+            "sets" => Ok(PrecedenceRule::Sets),
+            "plies" => Ok(PrecedenceRule::Plies),
+            _ => Err(format!("unknown precedence {s:?}: expected courses, sets or plies")),
+        }
+    }
+}
+
+impl std::fmt::Display for PrecedenceRule {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            PrecedenceRule::Courses => "courses",
+            PrecedenceRule::Sets => "sets",
+            PrecedenceRule::Plies => "plies",
+        })
+    }
+}
+
+/// What to optimize and under which rules.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct AfpOptions {
+    /// The cost model of transitions.
+    pub cost: CostKind,
+    /// Allow courses to be laid in reverse.
+    pub bidirectional: bool,
+    /// The precedence rule.
+    pub precedence: PrecedenceRule,
+    /// Keep the order of courses within each ply.
+    pub keep_ply_order: bool,
+    /// Course width (overrides the dialect's).
+    pub width: Option<Width>,
+}
+
+impl Default for AfpOptions {
+    fn default() -> Self {
+        AfpOptions {
+            cost: CostKind::Axis,
+            bidirectional: false,
+            precedence: PrecedenceRule::Courses,
+            keep_ply_order: false,
+            width: None,
+        }
+    }
+}
+
+impl AfpOptions {
+    /// The width to use: the options', else the dialect's (course width first).
+    pub fn width_or(&self, dialect: &Dialect) -> Option<Width> {
+        self.width.or(dialect.course_width.map(Width::Course)).or(dialect.tow_width.map(Width::Tow))
+    }
+}
+
+/// A program's courses as a sequencing problem, with everything needed to write the answer back.
+#[derive(Clone, Debug)]
+pub struct AfpProblem {
+    /// The problem: task `c` is course `c`; mode 0 forward, mode 1 (if any) reverse.
+    pub problem: Problem<MachineCost>,
+    /// Seed 000's precedence sets, in order, as lists of courses (each ply alone when there are
+    /// no footprints).
+    pub sets: Vec<Vec<usize>>,
+    /// The plies of each set.
+    pub set_plies: Vec<Vec<usize>>,
+    /// The original order: every course forward.
+    pub original: Vec<Step>,
+    /// How every course that has a reverse mode reverses (its lines are written when needed).
+    pub reversed: Vec<Option<Reversed>>,
+    /// Courses that could not be reversed, and why.
+    pub not_reversible: Vec<(usize, String)>,
+    /// The footprints, if computed.
+    pub footprints: Option<Footprints>,
+    /// Number of precedence edges given to the solver.
+    pub edges: usize,
+}
+
+/// Builds the sequencing problem of a parsed program.
+pub fn build_problem(
+    program: &Program,
+    machine: &Machine,
+    dialect: &Dialect,
+    opts: &AfpOptions,
+) -> Result<AfpProblem, NcError> {
+    let k = program.courses.len();
+    let plies: Vec<Vec<usize>> = program.plies.iter().map(|p| p.courses.clone()).collect();
+    let plies_with_courses = plies.iter().filter(|p| !p.is_empty()).count();
+    let width = opts.width_or(dialect);
+    let needs_fp = plies_with_courses > 1 && opts.precedence != PrecedenceRule::Plies;
+    let fps = match (needs_fp, width) {
+        (true, None) => {
+            return Err(NcError::Width(format!(
+                "the program has {plies_with_courses} plies and precedence between them needs course footprints: \
+                 give --tow-width MM or --course-width MM (or tow_width / course_width in the dialect), \
+                 or use --precedence plies"
+            )))
+        }
+        (true, Some(w)) => Some(footprints(program, machine, w)?),
+        (false, Some(w)) if machine.kinematics().is_some() => footprints(program, machine, w).ok(),
+        _ => None,
+    };
+    let set_plies = match &fps {
+        Some(f) => precedence_sets(f, &plies),
+        None => (0..plies.len()).map(|p| vec![p]).collect(),
+    };
+    let sets: Vec<Vec<usize>> =
+        set_plies.iter().map(|ps| ps.iter().flat_map(|&p| plies[p].iter().copied()).collect()).collect();
+
+    // Reversal.
+    let mut reversed: Vec<Option<Reversed>> = vec![None; k];
+    let mut not_reversible = Vec::new();
+    if opts.bidirectional {
+        use rayon::prelude::*;
+        let all: Vec<Result<Reversed, String>> =
+            (0..k).into_par_iter().map(|c| reversal_of(program, c, machine, dialect)).collect();
+        for (c, r) in all.into_iter().enumerate() {
+            match r {
+                Ok(r) => reversed[c] = Some(r),
+                Err(why) => not_reversible.push((c, why)),
+            }
+        }
+    }
+
+    // States and modes.
+    let mut states = StateTable::new(machine.dim());
+    let start = states.push(&program.start.phys)?;
+    let mut modes: Vec<Vec<(towpath_seq::StateId, towpath_seq::StateId)>> = Vec::with_capacity(k);
+    for (c, course) in program.courses.iter().enumerate() {
+        let mut m = vec![(states.push(&course.insert.phys)?, states.push(&course.exit.phys)?)];
+        if let Some(r) = &reversed[c] {
+            let mut exit = course.span_start.phys.clone();
+            if let Some(h) = machine.heading_axis() {
+                exit[h] += r.shift;
+            }
+            m.push((states.push(&r.entry.phys)?, states.push(&exit)?));
+        }
+        modes.push(m);
+    }
+    let end_state = footer_end(program, machine, dialect)?.map(|s| states.push(&s)).transpose()?;
+    let cost = MachineCost::new(machine.clone(), opts.cost, states)?;
+
+    // Each mode's own cost: its approach and retract moves.
+    let own: Vec<f64> = (0..k)
+        .map(|c| {
+            program.segments[program.courses[c].segments.clone()]
+                .iter()
+                .filter(|s| !s.on_part)
+                .map(|s| {
+                    let (a, b) = (program.point(s.from), program.point(s.to));
+                    let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| y - x).collect();
+                    cost.segment(a, b, &d)
+                })
+                .sum()
+        })
+        .collect();
+
+    let mut b = Problem::builder(cost);
+    for (c, ms) in modes.iter().enumerate() {
+        b.task(ms.iter().map(|&(e, x)| Mode { entry: e, exit: x, cost: own[c] }).collect());
+    }
+    let mut edges = 0;
+    match opts.precedence {
+        PrecedenceRule::Courses => {
+            if let Some(f) = &fps {
+                for (x, y) in course_precedence(f, &plies) {
+                    b.precede(TaskId(x as u32), TaskId(y as u32));
+                    edges += 1;
+                }
+            }
+        }
+        PrecedenceRule::Sets => {
+            for w in sets.windows(2) {
+                let (a, z): (Vec<TaskId>, Vec<TaskId>) = (
+                    w[0].iter().map(|&c| TaskId(c as u32)).collect(),
+                    w[1].iter().map(|&c| TaskId(c as u32)).collect(),
+                );
+                b.precede_groups(&a, &z);
+                edges += a.len() * z.len();
+            }
+        }
+        PrecedenceRule::Plies => {
+            let nonempty: Vec<&Vec<usize>> = plies.iter().filter(|p| !p.is_empty()).collect();
+            for w in nonempty.windows(2) {
+                let (a, z): (Vec<TaskId>, Vec<TaskId>) = (
+                    w[0].iter().map(|&c| TaskId(c as u32)).collect(),
+                    w[1].iter().map(|&c| TaskId(c as u32)).collect(),
+                );
+                b.precede_groups(&a, &z);
+                edges += a.len() * z.len();
+            }
+        }
+    }
+    if opts.keep_ply_order {
+        for p in &plies {
+            for w in p.windows(2) {
+                b.precede(TaskId(w[0] as u32), TaskId(w[1] as u32));
+                edges += 1;
+            }
+        }
+    }
+    b.start(start);
+    b.end(match end_state {
+        Some(s) => End::At(s),
+        None => End::Free,
+    });
+    let problem = b.build()?;
+    let original = (0..k).map(|c| Step { task: TaskId(c as u32), mode: 0 }).collect();
+    Ok(AfpProblem { problem, sets, set_plies, original, reversed, not_reversible, footprints: fps, edges })
+}
+
+/// The machine state at the end of the footer, if the footer's moves write every axis in
+/// absolute mode (so that it does not depend on where the last course left the machine).
+fn footer_end(program: &Program, machine: &Machine, dialect: &Dialect) -> Result<Option<Vec<f64>>, NcError> {
+    let last = match program.courses.last() {
+        Some(c) => c,
+        None => return Ok(None),
+    };
+    let mut it = Interp::new(dialect, machine)?;
+    it.m = last.exit.clone();
+    let mut written = vec![false; machine.dim()];
+    let mut moved = false;
+    for j in program.footer_start..program.lines.len() {
+        let a = it.apply(j, &program.lines[j])?;
+        if a.motion.is_some() {
+            moved = true;
+            if let Some(lexed) = &a.lexed {
+                for w in &lexed.words {
+                    if let Some(i) = it.axis_of(w.letter) {
+                        if !it.m.incremental {
+                            written[i] = true;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(if moved && written.iter().all(|&w| w) { Some(it.m.phys.clone()) } else { None })
+}
+
+/// Turns a solver's steps into placements.
+pub fn placements(steps: &[Step]) -> Vec<crate::rewrite::Placement> {
+    steps.iter().map(|s| crate::rewrite::Placement { course: s.task.index(), reversed: s.mode == 1 }).collect()
+}

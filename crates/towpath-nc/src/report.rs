@@ -1,0 +1,459 @@
+//! The savings report: totals per cost model, per ply and per precedence set, the new course
+//! order, as JSON (serde) or a self-contained HTML page with a before/after plan view.
+
+use std::fmt::Write as _;
+
+use serde::Serialize;
+use towpath_machine::{CostKind, Machine};
+
+use crate::footprint::{frame_for, Frame};
+use crate::optimize::{Optimized, SolverSummary, Timings};
+use crate::problem::PrecedenceRule;
+use crate::program::{ply_name, Program};
+use crate::verify::{Motion, Verification};
+
+/// Before/after figures under one cost model.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Totals {
+    /// The cost model.
+    pub kind: CostKind,
+    /// Its unit.
+    pub unit: &'static str,
+    /// Off-part motion of the input.
+    pub off_before: f64,
+    /// Off-part motion of the output.
+    pub off_after: f64,
+    /// Off-part saving, percent.
+    pub off_saved_percent: f64,
+    /// All motion of the input.
+    pub total_before: f64,
+    /// All motion of the output.
+    pub total_after: f64,
+    /// Total saving, percent.
+    pub total_saved_percent: f64,
+}
+
+/// Off-part figures of a group of courses under one cost model.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct GroupCost {
+    /// The cost model.
+    pub kind: CostKind,
+    /// Before.
+    pub before: f64,
+    /// After.
+    pub after: f64,
+    /// Saving, percent.
+    pub saved_percent: f64,
+}
+
+/// A ply or precedence set.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct GroupRow {
+    /// Its label.
+    pub label: String,
+    /// Courses in it.
+    pub courses: usize,
+    /// Off-part motion attributed to its courses (transit in, approach, retract).
+    pub off_part: Vec<GroupCost>,
+}
+
+/// One course of the new order.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OrderRow {
+    /// Position in the new program, from 1.
+    pub position: usize,
+    /// Position in the original program, from 1.
+    pub original: usize,
+    /// The ply's number or label.
+    pub ply: String,
+    /// The course number from its marker, if any.
+    pub number: Option<i64>,
+    /// The original line of its roller contact.
+    pub line: usize,
+    /// Laid in reverse.
+    pub reversed: bool,
+    /// Its seed-000 precedence set, from 1.
+    pub set: usize,
+}
+
+/// The savings report.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Report {
+    /// The program's name.
+    pub program: String,
+    /// The machine's name.
+    pub machine: String,
+    /// The cost model optimized.
+    pub cost: CostKind,
+    /// Reversal allowed.
+    pub bidirectional: bool,
+    /// Precedence rule.
+    pub precedence: PrecedenceRule,
+    /// Courses.
+    pub courses: usize,
+    /// Plies.
+    pub plies: usize,
+    /// Seed-000 precedence sets.
+    pub precedence_sets: usize,
+    /// Precedence edges given to the solver.
+    pub precedence_edges: usize,
+    /// Courses laid in reverse.
+    pub reversed: usize,
+    /// Courses that could not be reversed, and why.
+    pub not_reversible: Vec<String>,
+    /// Totals per cost model.
+    pub totals: Vec<Totals>,
+    /// Per ply.
+    pub per_ply: Vec<GroupRow>,
+    /// Per seed-000 precedence set.
+    pub per_set: Vec<GroupRow>,
+    /// Off-part motion of the header and footer (per cost model: before, after).
+    pub header_footer: Vec<GroupCost>,
+    /// The new order.
+    pub order: Vec<OrderRow>,
+    /// Solver figures.
+    pub solver: SolverSummary,
+    /// Stage times.
+    pub timings: Timings,
+    /// The output verified against the input.
+    pub verified: bool,
+    /// The input was returned unchanged because nothing cheaper was found.
+    pub fell_back: bool,
+}
+
+fn pct(before: f64, after: f64) -> f64 {
+    if before > 0.0 {
+        100.0 * (before - after) / before
+    } else {
+        0.0
+    }
+}
+
+fn group(label: String, courses: &[usize], v: &Verification) -> GroupRow {
+    let off_part = v
+        .before
+        .iter()
+        .zip(&v.after)
+        .map(|(b, a)| {
+            let (x, y): (f64, f64) =
+                (courses.iter().map(|&c| b.off_course[c]).sum(), courses.iter().map(|&c| a.off_course[c]).sum());
+            GroupCost { kind: b.kind, before: x, after: y, saved_percent: pct(x, y) }
+        })
+        .collect();
+    GroupRow { label, courses: courses.len(), off_part }
+}
+
+/// Totals of a verification.
+pub fn totals(v: &Verification) -> Vec<Totals> {
+    v.before
+        .iter()
+        .zip(&v.after)
+        .map(|(b, a): (&Motion, &Motion)| Totals {
+            kind: b.kind,
+            unit: b.kind.unit(),
+            off_before: b.off_part(),
+            off_after: a.off_part(),
+            off_saved_percent: pct(b.off_part(), a.off_part()),
+            total_before: b.total(),
+            total_after: a.total(),
+            total_saved_percent: pct(b.total(), a.total()),
+        })
+        .collect()
+}
+
+impl Report {
+    /// Builds the report of an optimization.
+    pub fn new(name: &str, machine: &Machine, o: &Optimized, opts: &crate::problem::AfpOptions) -> Report {
+        let p = &o.program;
+        let v = &o.verification;
+        let mut set_of = vec![0usize; p.courses.len()];
+        for (s, cs) in o.afp.sets.iter().enumerate() {
+            for &c in cs {
+                set_of[c] = s;
+            }
+        }
+        let per_ply = p.plies.iter().map(|ply| group(ply.label.clone(), &ply.courses, v)).collect();
+        let per_set = o
+            .afp
+            .set_plies
+            .iter()
+            .zip(&o.afp.sets)
+            .enumerate()
+            .map(|(i, (ps, cs))| {
+                let names: Vec<String> = ps.iter().map(|&x| ply_name(&p.plies[x])).collect();
+                group(format!("set {} (plies {})", i + 1, names.join(", ")), cs, v)
+            })
+            .collect();
+        let order = o
+            .order
+            .iter()
+            .enumerate()
+            .map(|(i, pl)| {
+                let c = &p.courses[pl.course];
+                OrderRow {
+                    position: i + 1,
+                    original: pl.course + 1,
+                    ply: ply_name(&p.plies[c.ply]),
+                    number: c.number,
+                    line: c.on_part.start + 1,
+                    reversed: pl.reversed,
+                    set: set_of[pl.course] + 1,
+                }
+            })
+            .collect();
+        Report {
+            program: name.to_string(),
+            machine: machine.name.clone(),
+            cost: opts.cost,
+            bidirectional: opts.bidirectional,
+            precedence: opts.precedence,
+            courses: p.courses.len(),
+            plies: p.plies.len(),
+            precedence_sets: o.afp.sets.len(),
+            precedence_edges: o.afp.edges,
+            reversed: v.reversed,
+            not_reversible: o
+                .afp
+                .not_reversible
+                .iter()
+                .map(|(c, why)| format!("{}: {why}", p.course_name(*c)))
+                .collect(),
+            totals: totals(v),
+            per_ply,
+            per_set,
+            header_footer: v
+                .before
+                .iter()
+                .zip(&v.after)
+                .map(|(b, a)| GroupCost {
+                    kind: b.kind,
+                    before: b.off_other,
+                    after: a.off_other,
+                    saved_percent: pct(b.off_other, a.off_other),
+                })
+                .collect(),
+            order,
+            solver: o.solver.clone(),
+            timings: o.timings.clone(),
+            verified: true,
+            fell_back: o.fell_back,
+        }
+    }
+
+    /// The totals under one cost model.
+    pub fn total(&self, kind: CostKind) -> Option<&Totals> {
+        self.totals.iter().find(|t| t.kind == kind)
+    }
+
+    /// A plain-text summary for a terminal.
+    pub fn summary(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "{}: {} courses in {} plies ({} precedence sets), machine {}, cost {}, {}",
+            self.program,
+            self.courses,
+            self.plies,
+            self.precedence_sets,
+            self.machine,
+            self.cost,
+            if self.bidirectional { "bidirectional" } else { "unidirectional" }
+        );
+        let _ = writeln!(
+            s,
+            "  {:<6} {:>14} {:>14} {:>8} {:>14} {:>14} {:>8}",
+            "cost", "off-part in", "off-part out", "saved", "total in", "total out", "saved"
+        );
+        for t in &self.totals {
+            let _ = writeln!(
+                s,
+                "  {:<6} {:>14.1} {:>14.1} {:>7.1}% {:>14.1} {:>14.1} {:>7.1}%   ({})",
+                t.kind.name(),
+                t.off_before,
+                t.off_after,
+                t.off_saved_percent,
+                t.total_before,
+                t.total_after,
+                t.total_saved_percent,
+                t.unit
+            );
+        }
+        let _ = writeln!(
+            s,
+            "  {} courses reversed; verified; {:.2} s (solve {:.2} s){}",
+            self.reversed,
+            self.timings.total,
+            self.timings.solve,
+            if self.fell_back { "; no cheaper order found: the input is returned unchanged" } else { "" }
+        );
+        s
+    }
+
+    /// A self-contained HTML page: tables and a before/after plan view.
+    pub fn to_html(&self, o: &Optimized, optimized: &Program, machine: &Machine) -> String {
+        let mut h = String::new();
+        let _ = write!(
+            h,
+            "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>towpath: {}</title><style>\
+             body{{font-family:system-ui,sans-serif;margin:2em;color:#222}}table{{border-collapse:collapse;margin:1em 0}}\
+             td,th{{border:1px solid #ccc;padding:.25em .6em;text-align:right}}th{{background:#f3f3f3}}\
+             td:first-child,th:first-child{{text-align:left}}.views{{display:flex;gap:1em;flex-wrap:wrap}}\
+             .views figure{{margin:0;border:1px solid #ccc}}figcaption{{padding:.3em;background:#f3f3f3}}</style></head><body>\n",
+            esc(&self.program)
+        );
+        let _ = writeln!(h, "<h1>towpath: {}</h1>", esc(&self.program));
+        let _ = writeln!(
+            h,
+            "<p>{} courses in {} plies, {} seed-000 precedence sets; machine <b>{}</b>; optimized for <b>{}</b> cost, {}, precedence by {}; {} courses reversed. Verified against the input.{}</p>",
+            self.courses,
+            self.plies,
+            self.precedence_sets,
+            esc(&self.machine),
+            self.cost,
+            if self.bidirectional { "bidirectional" } else { "unidirectional" },
+            self.precedence,
+            self.reversed,
+            if self.fell_back { " No cheaper order was found: the input is returned unchanged." } else { "" }
+        );
+        h.push_str("<h2>Totals</h2><table><tr><th>cost model</th><th>off-part before</th><th>off-part after</th><th>saved</th><th>total before</th><th>total after</th><th>saved</th><th>unit</th></tr>\n");
+        for t in &self.totals {
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1} %</td><td>{:.1}</td><td>{:.1}</td><td>{:.1} %</td><td>{}</td></tr>",
+                t.kind, t.off_before, t.off_after, t.off_saved_percent, t.total_before, t.total_after, t.total_saved_percent, t.unit
+            );
+        }
+        h.push_str("</table>\n");
+        h.push_str("<h2>Plan view</h2>\n");
+        match plan_views(o, optimized, machine) {
+            Some(svg) => h.push_str(&svg),
+            None => h.push_str("<p>(no drawing: the machine has no kinematics)</p>"),
+        }
+        for (title, rows) in [("Per ply", &self.per_ply), ("Per precedence set", &self.per_set)] {
+            let _ = write!(h, "<h2>{title}</h2><table><tr><th>group</th><th>courses</th>");
+            for t in &self.totals {
+                let _ = write!(h, "<th>{0} before</th><th>{0} after</th><th>saved</th>", t.kind);
+            }
+            h.push_str("</tr>\n");
+            for r in rows {
+                let _ = write!(h, "<tr><td>{}</td><td>{}</td>", esc(&r.label), r.courses);
+                for g in &r.off_part {
+                    let _ =
+                        write!(h, "<td>{:.1}</td><td>{:.1}</td><td>{:.1} %</td>", g.before, g.after, g.saved_percent);
+                }
+                h.push_str("</tr>\n");
+            }
+            h.push_str("</table>\n");
+        }
+        h.push_str("<h2>New course order</h2><table><tr><th>position</th><th>original position</th><th>ply</th><th>course</th><th>line</th><th>direction</th><th>set</th></tr>\n");
+        for r in &self.order {
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                r.position,
+                r.original,
+                esc(&r.ply),
+                r.number.map_or(String::new(), |n| n.to_string()),
+                r.line,
+                if r.reversed { "reversed" } else { "forward" },
+                r.set
+            );
+        }
+        h.push_str("</table>\n");
+        if !self.not_reversible.is_empty() {
+            h.push_str("<h2>Courses kept forward</h2><ul>");
+            for n in &self.not_reversible {
+                let _ = write!(h, "<li>{}</li>", esc(n));
+            }
+            h.push_str("</ul>\n");
+        }
+        h.push_str("</body></html>\n");
+        h
+    }
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// Polylines of a program in the frame: (on-part?, points).
+fn polylines(p: &Program, machine: &Machine, frame: &Frame) -> Vec<(bool, Vec<[f64; 2]>)> {
+    let Some(kin) = machine.kinematics() else { return Vec::new() };
+    let mut out: Vec<(bool, Vec<[f64; 2]>)> = Vec::new();
+    for s in &p.segments {
+        let a = frame.map(kin.part_point(p.point(s.from)));
+        let mut b = frame.map(kin.part_point(p.point(s.to)));
+        b[1] = frame.unwrap_near(b[1], a[1]);
+        if (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-9 {
+            continue;
+        }
+        match out.last_mut() {
+            Some((on, pts))
+                if *on == s.on_part && pts.last().is_some_and(|l| (l[0] - a[0]).abs() + (l[1] - a[1]).abs() < 1e-9) =>
+            {
+                pts.push(b)
+            }
+            _ => out.push((s.on_part, vec![a, b])),
+        }
+    }
+    out
+}
+
+fn plan_views(o: &Optimized, optimized: &Program, machine: &Machine) -> Option<String> {
+    let kin = machine.kinematics()?;
+    let frame = match &o.afp.footprints {
+        Some(f) => f.frame,
+        None => frame_for(&o.program, machine, &kin),
+    };
+    let before = polylines(&o.program, machine, &frame);
+    let after = polylines(optimized, machine, &frame);
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for (_, pts) in before.iter().chain(&after) {
+        for p in pts {
+            for k in 0..2 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+    }
+    if !(lo[0].is_finite() && hi[0] > lo[0] - 1.0) {
+        return None;
+    }
+    let (w, hgt) = ((hi[0] - lo[0]).max(1.0), (hi[1] - lo[1]).max(1.0));
+    let pad = 0.03 * w.max(hgt);
+    let stroke = 0.002 * w.max(hgt);
+    let view = |lines: &[(bool, Vec<[f64; 2]>)], off_color: &str, caption: &str, value: String| -> String {
+        let mut s = String::new();
+        let _ = write!(
+            s,
+            "<figure><svg xmlns=\"http://www.w3.org/2000/svg\" width=\"560\" viewBox=\"{} {} {} {}\" style=\"background:#fff\"><g transform=\"scale(1,-1)\">",
+            lo[0] - pad,
+            -hi[1] - pad,
+            w + 2.0 * pad,
+            hgt + 2.0 * pad
+        );
+        for (on, pts) in lines {
+            let d: Vec<String> = pts.iter().map(|p| format!("{:.1},{:.1}", p[0], p[1])).collect();
+            let (color, width) = if *on { ("#999", 4.0 * stroke) } else { (off_color, stroke) };
+            let _ = write!(
+                s,
+                "<polyline fill=\"none\" stroke=\"{color}\" stroke-width=\"{width:.2}\" stroke-linejoin=\"round\" points=\"{}\"/>",
+                d.join(" ")
+            );
+        }
+        let _ = write!(s, "</g></svg><figcaption>{caption}: {value}</figcaption></figure>");
+        s
+    };
+    let off = |m: &[Motion]| {
+        m.iter()
+            .find(|x| x.kind == CostKind::Tool)
+            .map_or(String::new(), |x| format!("off-part tool path {:.0} mm", x.off_part()))
+    };
+    let label = if matches!(frame, Frame::Cylinder { .. }) { " (cylinder unrolled)" } else { "" };
+    Some(format!(
+        "<div class=\"views\">{}{}</div><p>Grey: laid courses; red/blue: off-part motion{label}.</p>",
+        view(&before, "#d22", "before", off(&o.verification.before)),
+        view(&after, "#14c", "after", off(&o.verification.after))
+    ))
+}

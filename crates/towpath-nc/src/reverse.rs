@@ -1,0 +1,375 @@
+//! Reversal of a course: its span (approach, on-part, retract) run backwards.
+//!
+//! The reversed span visits the same points in reverse order, with the heading axis turned by
+//! 180°. Tow restarts and cuts stay at the same points with restart and cut swapped (so the same
+//! tows are on along every piece of the path), and roller contact on and off swap likewise. The
+//! original retract, reversed, becomes the approach (it moves with the original approach's
+//! motion code and feed), and the original approach, reversed, becomes the retract. Lines that
+//! neither move nor change modes stay at their point. Axis values are written with the
+//! original text (the heading axis: the original decimal text plus or minus 180, exactly).
+
+use towpath_machine::{AxisKind, Machine};
+
+use crate::dialect::Dialect;
+use crate::interp::{Event, Interp, Modal};
+use crate::lex::Lexed;
+use crate::program::Program;
+
+/// A course's span, reversed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reversed {
+    /// The lines of the reversed span (empty from [`reversal_of`]).
+    pub lines: Vec<String>,
+    /// The state the machine must be in before them (absolute mode).
+    pub entry: Modal,
+    /// The heading shift used (+180 or −180), 0 if the machine has no heading axis.
+    pub shift: f64,
+}
+
+/// Which block of the span a move belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Part {
+    Approach,
+    On,
+    Retract,
+}
+
+#[derive(Clone, Debug)]
+struct Move {
+    part: Part,
+    rapid: bool,
+    feed: Option<String>,
+    comment: Option<String>,
+}
+
+#[derive(Clone, Debug)]
+enum StationItem {
+    /// An original line kept as it is (comments, unknown words).
+    Line(String),
+    /// An event line: the original text with its code word swapped.
+    Event(String),
+}
+
+/// Builds the reversed span of course `c`, or says why it cannot be reversed.
+pub fn reverse_course(program: &Program, c: usize, machine: &Machine, dialect: &Dialect) -> Result<Reversed, String> {
+    reverse_span(program, c, machine, dialect, true)
+}
+
+/// Like [`reverse_course`], but without writing the lines (`lines` is left empty): enough to
+/// know whether and how the course reverses.
+pub fn reversal_of(program: &Program, c: usize, machine: &Machine, dialect: &Dialect) -> Result<Reversed, String> {
+    reverse_span(program, c, machine, dialect, false)
+}
+
+fn reverse_span(
+    program: &Program,
+    c: usize,
+    machine: &Machine,
+    dialect: &Dialect,
+    write: bool,
+) -> Result<Reversed, String> {
+    let course = &program.courses[c];
+    let codes = dialect.codes().map_err(|e| e.to_string())?;
+    let mut it = Interp::new(dialect, machine).map_err(|e| e.to_string())?;
+    it.m = course.span_start.clone();
+    let dim = machine.dim();
+
+    // Walk the span: stations (points) with their items, and the moves between them.
+    let mut prog: Vec<Vec<f64>> = vec![it.m.prog.clone()];
+    let mut text: Vec<Vec<Option<crate::lex::NumText>>> = vec![it.m.text.clone()];
+    let mut stations: Vec<Vec<StationItem>> = vec![Vec::new()];
+    let mut moves: Vec<Move> = Vec::new();
+    for j in course.span.clone() {
+        let line = program.lines[j].trim_end_matches('\r');
+        let a = it.apply(j, line).map_err(|e| e.to_string())?;
+        let part = if j < course.on_part.start {
+            Part::Approach
+        } else if j < course.on_part.end {
+            Part::On
+        } else {
+            Part::Retract
+        };
+        if a.set_position {
+            return Err(format!("line {} sets positions inside the course", j + 1));
+        }
+        let lexed = a.lexed.clone().unwrap_or_default();
+        if let Some(rapid) = a.motion {
+            if a.unknown {
+                return Err(format!("line {} has words towpath does not know on a move", j + 1));
+            }
+            let event_text = |evs: &[Event]| -> Vec<StationItem> {
+                evs.iter().map(|e| StationItem::Event(swapped_event(e, dialect, &lexed))).collect()
+            };
+            if let Some(s) = stations.last_mut() {
+                s.extend(event_text(&a.before));
+            }
+            moves.push(Move {
+                part,
+                rapid,
+                feed: if rapid { None } else { it.m.feed.as_ref().map(|f| f.1.to_string()) },
+                comment: if lexed.comments.is_empty() { None } else { Some(lexed.comments.join(" ")) },
+            });
+            prog.push(it.m.prog.clone());
+            text.push(it.m.text.clone());
+            stations.push(event_text(&a.after));
+        } else if a.events {
+            if a.modal {
+                return Err(format!("line {} mixes mode changes and tow or contact codes", j + 1));
+            }
+            let evs: Vec<Event> = a.events().copied().collect();
+            if evs.len() != 1 {
+                return Err(format!("line {} has several tow or contact codes", j + 1));
+            }
+            let item = StationItem::Event(swap_line_code(line, &evs[0], dialect, &codes, &lexed));
+            if let Some(s) = stations.last_mut() {
+                s.push(item);
+            }
+        } else if a.modal {
+            if a.unknown {
+                return Err(format!("line {} mixes mode changes with words towpath does not know", j + 1));
+            }
+            // A pure mode change: the reversed moves carry their own modes.
+        } else {
+            if let Some(s) = stations.last_mut() {
+                s.push(StationItem::Line(line.to_string()));
+            }
+        }
+    }
+
+    // The heading shift.
+    let mut shift = 0.0;
+    if let Some(h) = machine.heading_axis() {
+        let ax = &machine.axes[h];
+        let lo = prog.iter().map(|p| p[h]).fold(f64::INFINITY, f64::min);
+        let hi = prog.iter().map(|p| p[h]).fold(f64::NEG_INFINITY, f64::max);
+        shift = match ax.kind {
+            AxisKind::Rotary => {
+                let fits =
+                    |s: f64| ax.max.is_none_or(|m| hi + s <= m + 1e-9) && ax.min.is_none_or(|m| lo + s >= m - 1e-9);
+                if fits(180.0) {
+                    180.0
+                } else if fits(-180.0) {
+                    -180.0
+                } else {
+                    return Err(format!("turning the heading axis {} by 180° leaves its travel limits", ax.label));
+                }
+            }
+            _ => {
+                if hi + 180.0 > 360.0 {
+                    -180.0
+                } else {
+                    180.0
+                }
+            }
+        };
+    }
+    let heading = machine.heading_axis();
+    let value_text = |k: usize, i: usize| -> String {
+        let t = text[k][i].as_ref().map(|x| x.as_str());
+        if Some(i) == heading {
+            match t {
+                Some(t) => shift_decimal(t, shift).unwrap_or_else(|| fmt_num(prog[k][i] + shift, dialect.decimals)),
+                None => fmt_num(prog[k][i] + shift, dialect.decimals),
+            }
+        } else {
+            match t {
+                Some(t) => t.to_string(),
+                None => fmt_num(prog[k][i], dialect.decimals),
+            }
+        }
+    };
+
+    // Motion code and feed for reversed approach and retract moves.
+    let last_approach = moves.iter().rev().find(|m| m.part == Part::Approach).cloned();
+    let first_retract = moves.iter().find(|m| m.part == Part::Retract).cloned();
+    let rapid_code = dialect.rapid.first().cloned().unwrap_or_else(|| "G0".into());
+    let feed_code = dialect.feed.first().cloned().unwrap_or_else(|| "G1".into());
+
+    let n = moves.len();
+    let mut lines = Vec::new();
+    let stations_to_write = if write { n + 1 } else { 0 };
+    let mut cur: Vec<String> = (0..dim).map(|i| value_text(n, i)).collect();
+    let mut cur_rapid: Option<bool> = None;
+    let mut cur_feed: Option<String> = None;
+    for s in (0..stations_to_write).rev() {
+        for item in stations[s].iter().rev() {
+            match item {
+                StationItem::Line(t) | StationItem::Event(t) => lines.push(t.clone()),
+            }
+        }
+        if s == 0 {
+            break;
+        }
+        let mv = &moves[s - 1];
+        let template = match mv.part {
+            Part::Approach => first_retract.as_ref().unwrap_or(mv),
+            Part::Retract => last_approach.as_ref().unwrap_or(mv),
+            Part::On => mv,
+        };
+        let mut words = Vec::new();
+        if cur_rapid != Some(template.rapid) {
+            words.push(if template.rapid { rapid_code.clone() } else { feed_code.clone() });
+            cur_rapid = Some(template.rapid);
+        }
+        for i in 0..dim {
+            let t = value_text(s - 1, i);
+            if t != cur[i] || prog[s - 1][i] != prog[s][i] {
+                words.push(format!("{}{}", machine.axes[i].label.to_ascii_uppercase(), t));
+                cur[i] = t;
+            }
+        }
+        if !template.rapid {
+            if let Some(f) = &template.feed {
+                if cur_feed.as_ref() != Some(f) {
+                    words.push(format!("{}{}", dialect.feed_word.to_ascii_uppercase(), f));
+                    cur_feed = Some(f.clone());
+                }
+            }
+        }
+        if !words.iter().any(|w| machine.axes.iter().any(|a| w.starts_with(&a.label.to_ascii_uppercase()))) {
+            // A move to the same point: write one axis so that it stays a move.
+            words.push(format!("{}{}", machine.axes[0].label.to_ascii_uppercase(), cur[0]));
+        }
+        let mut l = words.join(" ");
+        if let Some(cm) = &mv.comment {
+            l.push(' ');
+            l.push_str(&dialect.comment(cm));
+        }
+        lines.push(l);
+    }
+
+    let mut entry = course.span_start.clone();
+    entry.prog = prog[n].clone();
+    entry.text = text[n].clone();
+    for i in 0..dim {
+        entry.phys[i] = course.span_start.phys[i] - course.span_start.prog[i] + prog[n][i];
+    }
+    if let Some(h) = heading {
+        entry.prog[h] += shift;
+        entry.phys[h] += shift;
+        entry.text[h] = crate::lex::NumText::new(&value_text(n, h));
+    }
+    entry.incremental = false;
+    entry.contact = false;
+    entry.mask = 0;
+    Ok(Reversed { lines, entry, shift })
+}
+
+/// The text of an event split off a motion line: the swapped code and, for tows, the mask.
+fn swapped_event(e: &Event, dialect: &Dialect, lexed: &Lexed) -> String {
+    let _ = lexed;
+    match *e {
+        Event::Contact(on) => {
+            if on {
+                dialect.contact_off.clone()
+            } else {
+                dialect.contact_on.clone()
+            }
+        }
+        Event::Tow(restart, mask) => {
+            let code = if restart { &dialect.tow_cut } else { &dialect.tow_restart };
+            format!("{code} {}{mask}", dialect.tow_mask_word.to_ascii_uppercase())
+        }
+    }
+}
+
+/// An event line with its code word swapped (restart ↔ cut, contact on ↔ off), the rest kept.
+fn swap_line_code(line: &str, e: &Event, dialect: &Dialect, codes: &crate::dialect::Codes, lexed: &Lexed) -> String {
+    let (from, to) = match *e {
+        Event::Contact(on) => match &codes.contact {
+            Some((c_on, c_off)) => {
+                if on {
+                    (*c_on, dialect.contact_off.clone())
+                } else {
+                    (*c_off, dialect.contact_on.clone())
+                }
+            }
+            None => return swapped_event(e, dialect, lexed),
+        },
+        Event::Tow(restart, _) => {
+            if restart {
+                (codes.restart, dialect.tow_cut.clone())
+            } else {
+                (codes.cut, dialect.tow_restart.clone())
+            }
+        }
+    };
+    match lexed.words.iter().find(|w| from.matches(w.letter, w.value)) {
+        Some(w) => format!("{}{}{}", &line[..w.span.start], to, &line[w.span.end..]),
+        None => swapped_event(e, dialect, lexed),
+    }
+}
+
+/// Formats a number with at most `decimals` digits after the point, trailing zeros dropped.
+pub fn fmt_num(v: f64, decimals: usize) -> String {
+    let mut s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        while s.ends_with('0') {
+            s.pop();
+        }
+        if s.ends_with('.') {
+            s.pop();
+        }
+    }
+    if s == "-0" {
+        s = "0".into();
+    }
+    s
+}
+
+/// Adds a whole number of degrees to a decimal text exactly, keeping its digits after the point.
+pub fn shift_decimal(text: &str, shift: f64) -> Option<String> {
+    if shift.fract() != 0.0 || shift.abs() > 1e6 {
+        return None;
+    }
+    let t = text.trim();
+    let (neg, body) = match t.strip_prefix('-') {
+        Some(b) => (true, b),
+        None => (false, t.strip_prefix('+').unwrap_or(t)),
+    };
+    let (int, frac) = match body.split_once('.') {
+        Some((i, f)) => (i, f),
+        None => (body, ""),
+    };
+    if !(int.chars().all(|c| c.is_ascii_digit()) && frac.chars().all(|c| c.is_ascii_digit())) || frac.len() > 18 {
+        return None;
+    }
+    if int.is_empty() && frac.is_empty() {
+        return None;
+    }
+    let scale = 10i128.checked_pow(frac.len() as u32)?;
+    let digits: i128 = format!("{}{}", if int.is_empty() { "0" } else { int }, frac).parse().ok()?;
+    let value = if neg { -digits } else { digits };
+    let shifted = value.checked_add((shift as i128).checked_mul(scale)?)?;
+    let (sign, mag) = if shifted < 0 { ("-", -shifted) } else { ("", shifted) };
+    let whole = mag / scale;
+    let part = mag % scale;
+    Some(if frac.is_empty() {
+        format!("{sign}{whole}")
+    } else {
+        format!("{sign}{whole}.{part:0width$}", width = frac.len())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decimal_shift_is_exact() {
+        assert_eq!(shift_decimal("12.345", 180.0).unwrap(), "192.345");
+        assert_eq!(shift_decimal("-12.5", 180.0).unwrap(), "167.5");
+        assert_eq!(shift_decimal("100", -180.0).unwrap(), "-80");
+        assert_eq!(shift_decimal(".25", 180.0).unwrap(), "180.25");
+        assert_eq!(shift_decimal("-0.250", -180.0).unwrap(), "-180.250");
+        assert_eq!(shift_decimal("190.000", -180.0).unwrap(), "10.000");
+        assert!(shift_decimal("1e5", 180.0).is_none());
+    }
+
+    #[test]
+    fn numbers_are_trimmed() {
+        assert_eq!(fmt_num(1.5, 4), "1.5");
+        assert_eq!(fmt_num(-0.00001, 4), "0");
+        assert_eq!(fmt_num(10.0, 3), "10");
+    }
+}

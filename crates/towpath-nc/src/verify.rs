@@ -1,0 +1,663 @@
+//! The verifier: checks an optimized program against its original, independently of the
+//! optimizer (it shares only the parser and the footprint geometry).
+//!
+//! It checks that the optimized program lays the same multiset of courses, each either with
+//! the same motion (points, tows on, feeds; its span byte-identical, or, if written anew,
+//! keeping its comments and unknown lines), or as a legal reversal (the same points in reverse order, the heading axis turned by 180°, the same tows
+//! on along every move, the same feeds on-part); that every line the original keeps (header,
+//! footer, comments and unknown lines) is still there; and that no course is laid before a
+//! course of an earlier ply it overlaps. It measures the off-part and on-part motion of both
+//! programs under every cost model the machine supports.
+
+use std::collections::HashMap;
+
+use serde::Serialize;
+use towpath_machine::{CostKind, Machine, MachineCost, StateTable};
+
+use crate::dialect::Dialect;
+use crate::error::NcError;
+use crate::footprint::{footprints, Footprints, Width};
+use crate::lex::lex;
+use crate::program::{Item, Program, Region};
+use crate::rewrite::Placement;
+
+/// What the verifier checks beyond the course rule.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct VerifyOptions {
+    /// Course width, for the footprints of the precedence check (else the dialect's).
+    pub width: Option<Width>,
+    /// Also require every ply to be laid after the one before.
+    pub strict_plies: bool,
+    /// Also require the courses of each ply in their original order.
+    pub keep_ply_order: bool,
+}
+
+/// Why an optimized program does not verify.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum VerifyError {
+    /// The original program could not be read.
+    #[error("original program: {0}")]
+    Original(NcError),
+    /// The optimized program could not be read.
+    #[error("optimized program: {0}")]
+    Optimized(NcError),
+    /// The verification needs something it was not given.
+    #[error("{0}")]
+    Setup(NcError),
+    /// The numbers of courses differ.
+    #[error("the optimized program has {got} courses, the original {expected}")]
+    CourseCount {
+        /// Courses in the optimized program.
+        got: usize,
+        /// Courses in the original.
+        expected: usize,
+    },
+    /// A course of the optimized program is no course of the original.
+    #[error("optimized program line {line}: this course is not a course of the original, forward or legally reversed{detail}")]
+    Unmatched {
+        /// 1-based line of the course's roller contact in the optimized program.
+        line: usize,
+        /// What differs from the closest candidate, if there was one.
+        detail: String,
+    },
+    /// A course of the original is not laid.
+    #[error("{0} of the original is not laid by the optimized program")]
+    Missing(String),
+    /// A line the original keeps is gone.
+    #[error("original line {line} ({text:?}) is missing from the optimized program")]
+    LostLine {
+        /// 1-based line in the original.
+        line: usize,
+        /// Its text.
+        text: String,
+    },
+    /// A course is laid before a course it must follow.
+    #[error("precedence broken: {after} is laid before {before}, which it overlaps and must follow")]
+    Precedence {
+        /// The course that must come first.
+        before: String,
+        /// The course that came too early.
+        after: String,
+    },
+    /// A ply or within-ply order rule is broken.
+    #[error("order broken: {0}")]
+    Order(String),
+}
+
+/// Off-part and on-part motion of one program under one cost model.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Motion {
+    /// The cost model.
+    pub kind: CostKind,
+    /// Off-part motion attributed to each course (its transit in, approach and retract),
+    /// indexed by the original course.
+    pub off_course: Vec<f64>,
+    /// Off-part motion of the header and footer.
+    pub off_other: f64,
+    /// On-part motion.
+    pub on_part: f64,
+}
+
+impl Motion {
+    /// Total off-part motion.
+    pub fn off_part(&self) -> f64 {
+        self.off_course.iter().sum::<f64>() + self.off_other
+    }
+    /// Off-part plus on-part motion.
+    pub fn total(&self) -> f64 {
+        self.off_part() + self.on_part
+    }
+}
+
+/// A successful verification.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Verification {
+    /// Courses checked.
+    pub courses: usize,
+    /// Courses laid in reverse.
+    pub reversed: usize,
+    /// The optimized program's courses, as original courses.
+    pub order: Vec<Placement>,
+    /// True if precedence between plies was checked on footprints.
+    pub precedence_checked: bool,
+    /// Motion of the original, per cost model.
+    pub before: Vec<Motion>,
+    /// Motion of the optimized program, per cost model (courses indexed as in the original).
+    pub after: Vec<Motion>,
+}
+
+impl Verification {
+    /// The motion before and after under one cost model, if the machine supports it.
+    pub fn motion(&self, kind: CostKind) -> Option<(&Motion, &Motion)> {
+        let b = self.before.iter().find(|m| m.kind == kind)?;
+        let a = self.after.iter().find(|m| m.kind == kind)?;
+        Some((b, a))
+    }
+}
+
+/// Verifies program text `optimized` against `original`.
+pub fn verify(
+    original: &str,
+    optimized: &str,
+    machine: &Machine,
+    dialect: &Dialect,
+    opts: &VerifyOptions,
+) -> Result<Verification, VerifyError> {
+    let orig = crate::parse::parse(original, machine, dialect).map_err(VerifyError::Original)?;
+    let opt = crate::parse::parse(optimized, machine, dialect).map_err(VerifyError::Optimized)?;
+    verify_parsed(&orig, &opt, machine, dialect, opts, None)
+}
+
+/// Verifies parsed programs; `fps` may pass the original's footprints if already built.
+pub fn verify_parsed(
+    orig: &Program,
+    opt: &Program,
+    machine: &Machine,
+    dialect: &Dialect,
+    opts: &VerifyOptions,
+    fps: Option<&Footprints>,
+) -> Result<Verification, VerifyError> {
+    let k = orig.courses.len();
+    if opt.courses.len() != k {
+        return Err(VerifyError::CourseCount { got: opt.courses.len(), expected: k });
+    }
+    let tol = (0.5 * 10f64.powi(-(dialect.decimals as i32))).max(1e-6);
+    check_header_footer(orig, opt)?;
+    let (order, rewritten) = match_courses(orig, opt, machine, tol)?;
+    check_kept_lines(orig, opt, &order, &rewritten, dialect)?;
+
+    // Precedence.
+    let plies_with_courses = orig.plies.iter().filter(|p| !p.courses.is_empty()).count();
+    let mut precedence_checked = false;
+    if plies_with_courses > 1 {
+        let width = opts.width.or(dialect.course_width.map(Width::Course)).or(dialect.tow_width.map(Width::Tow));
+        let owned;
+        let fps = match (fps, width) {
+            (Some(f), _) => f,
+            (None, Some(w)) => {
+                owned = footprints(orig, machine, w).map_err(VerifyError::Setup)?;
+                &owned
+            }
+            (None, None) => {
+                return Err(VerifyError::Setup(NcError::Width(
+                    "checking precedence between plies needs course footprints: give --tow-width MM or \
+                     --course-width MM (or tow_width / course_width in the dialect)"
+                        .into(),
+                )))
+            }
+        };
+        check_precedence(orig, fps, &order)?;
+        precedence_checked = true;
+    }
+    let mut pos = vec![0usize; k];
+    for (i, p) in order.iter().enumerate() {
+        pos[p.course] = i;
+    }
+    if opts.strict_plies {
+        for w in orig.plies.iter().filter(|p| !p.courses.is_empty()).collect::<Vec<_>>().windows(2) {
+            let last_a = w[0].courses.iter().map(|&c| pos[c]).max().unwrap_or(0);
+            let first_b = w[1].courses.iter().map(|&c| pos[c]).min().unwrap_or(0);
+            if first_b < last_a {
+                return Err(VerifyError::Order(format!(
+                    "ply {:?} starts before ply {:?} is finished",
+                    w[1].label, w[0].label
+                )));
+            }
+        }
+    }
+    if opts.keep_ply_order {
+        for p in &orig.plies {
+            for w in p.courses.windows(2) {
+                if pos[w[1]] < pos[w[0]] {
+                    return Err(VerifyError::Order(format!(
+                        "{} comes before {} within the ply",
+                        orig.course_name(w[1]),
+                        orig.course_name(w[0])
+                    )));
+                }
+            }
+        }
+    }
+
+    let mut inverse = vec![0usize; k];
+    for (i, p) in order.iter().enumerate() {
+        inverse[i] = p.course;
+    }
+    let identity: Vec<usize> = (0..k).collect();
+    let before = measure(orig, machine, &identity, orig.header_end, orig.footer_start);
+    // The optimized program starts with the original's header and ends with its footer.
+    let footer_len = orig.lines.len() - orig.footer_start;
+    let after = measure(opt, machine, &inverse, orig.header_end, opt.lines.len() - footer_len);
+    Ok(Verification {
+        courses: k,
+        reversed: order.iter().filter(|p| p.reversed).count(),
+        order,
+        precedence_checked,
+        before,
+        after,
+    })
+}
+
+/// The span of a course as points (physical values), with each move's (on-part, tows, feed).
+struct SpanMotion {
+    points: Vec<Vec<f64>>,
+    moves: Vec<(bool, u64, f64)>,
+}
+
+fn span_motion(p: &Program, c: usize) -> SpanMotion {
+    let course = &p.courses[c];
+    let mut points = vec![course.span_start.phys.clone()];
+    let mut moves = Vec::new();
+    for s in &p.segments[course.segments.clone()] {
+        points.push(p.point(s.to).to_vec());
+        moves.push((s.on_part, s.mask, s.feed));
+    }
+    SpanMotion { points, moves }
+}
+
+fn same_value(machine: &Machine, i: usize, a: f64, b: f64, turn: f64, tol: f64) -> bool {
+    let d = b - a - turn;
+    if machine.axes[i].kind.wraps() || turn != 0.0 {
+        let r = d - 360.0 * (d / 360.0).round();
+        r.abs() <= tol
+    } else {
+        d.abs() <= tol
+    }
+}
+
+fn same_feed(a: f64, b: f64) -> bool {
+    (a.is_nan() && b.is_nan()) || a == b
+}
+
+/// Checks that `opt`'s course `kc` is `orig`'s course `oc` laid forward.
+fn is_forward(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Machine, tol: f64) -> Result<(), String> {
+    let (a, b) = (span_motion(orig, oc), span_motion(opt, kc));
+    if a.moves.len() != b.moves.len() {
+        return Err(format!("{} moves instead of {}", b.moves.len(), a.moves.len()));
+    }
+    for (i, (pa, pb)) in a.points.iter().zip(&b.points).enumerate() {
+        for ax in 0..machine.dim() {
+            if !same_value(machine, ax, pa[ax], pb[ax], 0.0, tol) {
+                return Err(format!("point {i}: axis {} is {} instead of {}", machine.axes[ax].label, pb[ax], pa[ax]));
+            }
+        }
+    }
+    for (i, (ma, mb)) in a.moves.iter().zip(&b.moves).enumerate() {
+        if ma.0 != mb.0 || ma.1 != mb.1 || (ma.0 && !same_feed(ma.2, mb.2)) {
+            return Err(format!("move {i}: contact, tows or feed differ"));
+        }
+    }
+    Ok(())
+}
+
+/// Checks that `opt`'s course `kc` is `orig`'s course `oc` legally reversed.
+fn is_reversal(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Machine, tol: f64) -> Result<(), String> {
+    let (a, b) = (span_motion(orig, oc), span_motion(opt, kc));
+    let n = a.moves.len();
+    if n != b.moves.len() {
+        return Err(format!("{} moves instead of {}", b.moves.len(), n));
+    }
+    let heading = machine.heading_axis();
+    for i in 0..=n {
+        let (pa, pb) = (&a.points[n - i], &b.points[i]);
+        for ax in 0..machine.dim() {
+            let turn = if Some(ax) == heading { 180.0 } else { 0.0 };
+            if !same_value(machine, ax, pa[ax], pb[ax], turn, tol) {
+                return Err(format!(
+                    "reversed point {i}: axis {} is {} where the original's point {} has {}{}",
+                    machine.axes[ax].label,
+                    pb[ax],
+                    n - i,
+                    pa[ax],
+                    if turn != 0.0 { " (±180)" } else { "" }
+                ));
+            }
+        }
+    }
+    for i in 0..n {
+        let (ma, mb) = (&a.moves[n - 1 - i], &b.moves[i]);
+        if ma.0 != mb.0 {
+            return Err(format!("reversed move {i}: roller contact differs from the original's move {}", n - 1 - i));
+        }
+        if ma.1 != mb.1 {
+            return Err(format!(
+                "reversed move {i}: tows on {} where the original's move {} has {} (restart and cut must swap at the same points)",
+                mb.1,
+                n - 1 - i,
+                ma.1
+            ));
+        }
+        if ma.0 && !same_feed(ma.2, mb.2) {
+            return Err(format!("reversed move {i}: feed {} instead of {}", mb.2, ma.2));
+        }
+    }
+    Ok(())
+}
+
+fn span_text(p: &Program, c: usize) -> String {
+    let mut s = String::new();
+    for l in &p.lines[p.courses[c].span.clone()] {
+        s.push_str(l.trim_end_matches('\r'));
+        s.push('\n');
+    }
+    s
+}
+
+/// Grid cell (0.5 mm or 0.5°) of the first two non-heading axes of a point, for finding
+/// reversal candidates; angles modulo a turn.
+fn point_cell(machine: &Machine, p: &[f64]) -> Vec<(i64, Option<i64>)> {
+    let heading = machine.heading_axis();
+    (0..machine.dim())
+        .filter(|&i| Some(i) != heading)
+        .take(2)
+        .map(|i| {
+            let v = (p[i] / 0.5).floor() as i64;
+            if machine.axes[i].kind.wraps() {
+                (v.rem_euclid(720), Some(720))
+            } else {
+                (v, None)
+            }
+        })
+        .collect()
+}
+
+/// The cell and its neighbours.
+fn neighbour_cells(cell: &[(i64, Option<i64>)]) -> Vec<Vec<i64>> {
+    let mut out: Vec<Vec<i64>> = vec![Vec::new()];
+    for &(v, period) in cell {
+        let mut next = Vec::with_capacity(out.len() * 3);
+        for base in &out {
+            for d in -1..=1 {
+                let x = match period {
+                    Some(p) => (v + d).rem_euclid(p),
+                    None => v + d,
+                };
+                let mut b = base.clone();
+                b.push(x);
+                next.push(b);
+            }
+        }
+        out = next;
+    }
+    out.sort();
+    out.dedup();
+    out
+}
+
+/// Matches every course of `opt` to a course of `orig`: by identical span text and motion, else
+/// by identical motion (written differently), else as a legal reversal. Returns the placements
+/// and, per placement, whether its lines were written anew (reversed, or rewritten forward).
+fn match_courses(
+    orig: &Program,
+    opt: &Program,
+    machine: &Machine,
+    tol: f64,
+) -> Result<(Vec<Placement>, Vec<bool>), VerifyError> {
+    let k = orig.courses.len();
+    let mut by_text: HashMap<String, Vec<usize>> = HashMap::new();
+    for c in (0..k).rev() {
+        by_text.entry(span_text(orig, c)).or_default().push(c);
+    }
+    let mut by_end: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
+    let mut by_start: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
+    for c in (0..k).rev() {
+        let key: Vec<i64> = point_cell(machine, &orig.courses[c].exit.phys).iter().map(|x| x.0).collect();
+        by_end.entry(key).or_default().push(c);
+        let key: Vec<i64> = point_cell(machine, &orig.courses[c].span_start.phys).iter().map(|x| x.0).collect();
+        by_start.entry(key).or_default().push(c);
+    }
+    let near = |map: &HashMap<Vec<i64>, Vec<usize>>, p: &[f64]| -> Vec<usize> {
+        let mut v: Vec<usize> = neighbour_cells(&point_cell(machine, p))
+            .iter()
+            .filter_map(|key| map.get(key))
+            .flat_map(|v| v.iter().copied())
+            .collect();
+        v.sort_unstable();
+        v
+    };
+    let mut used = vec![false; k];
+    let mut order = Vec::with_capacity(k);
+    let mut rewritten = Vec::with_capacity(k);
+    for kc in 0..k {
+        let text = span_text(opt, kc);
+        let mut found = None;
+        let mut detail = String::new();
+        if let Some(cands) = by_text.get(&text) {
+            for &oc in cands.iter().rev() {
+                if used[oc] {
+                    continue;
+                }
+                match is_forward(orig, oc, opt, kc, machine, tol) {
+                    Ok(()) => {
+                        found = Some(Placement { course: oc, reversed: false });
+                        break;
+                    }
+                    Err(e) => detail = format!(": same lines as {} but {e}", orig.course_name(oc)),
+                }
+            }
+        }
+        let by_text = found.is_some();
+        let start = &opt.courses[kc].span_start.phys;
+        if found.is_none() {
+            for oc in near(&by_start, start) {
+                if !used[oc] && is_forward(orig, oc, opt, kc, machine, tol).is_ok() {
+                    found = Some(Placement { course: oc, reversed: false });
+                    break;
+                }
+            }
+        }
+        if found.is_none() {
+            let cands = near(&by_end, start);
+            if cands.is_empty() && detail.is_empty() {
+                detail = ": no course of the original ends where it starts".into();
+            }
+            {
+                for &oc in cands.iter() {
+                    if used[oc] {
+                        continue;
+                    }
+                    match is_reversal(orig, oc, opt, kc, machine, tol) {
+                        Ok(()) => {
+                            found = Some(Placement { course: oc, reversed: true });
+                            break;
+                        }
+                        Err(e) => detail = format!(": not a legal reversal of {}: {e}", orig.course_name(oc)),
+                    }
+                }
+            }
+        }
+        match found {
+            Some(p) => {
+                used[p.course] = true;
+                rewritten.push(!by_text);
+                order.push(p);
+            }
+            None => return Err(VerifyError::Unmatched { line: opt.courses[kc].on_part.start + 1, detail }),
+        }
+    }
+    if let Some(c) = used.iter().position(|u| !u) {
+        return Err(VerifyError::Missing(orig.course_name(c)));
+    }
+    Ok((order, rewritten))
+}
+
+/// A line that must survive: not a move, and no tow, contact or mode codes (those are checked
+/// through the motion).
+fn must_keep(line: &str, dialect: &Dialect) -> bool {
+    let Ok(l) = lex(line, dialect.comment_parens, dialect.comment_semicolon) else {
+        return !line.trim().is_empty();
+    };
+    let codes = [&dialect.contact_on, &dialect.contact_off, &dialect.tow_restart, &dialect.tow_cut];
+    let modal_or_event = l.words.iter().any(|w| {
+        w.letter == 'G'
+            || w.letter.to_string().eq_ignore_ascii_case(&dialect.feed_word)
+            || codes.iter().any(|c| crate::dialect::Code::parse(c).is_some_and(|c| c.matches(w.letter, w.value)))
+    });
+    let blank = l.words.is_empty() && l.comments.is_empty();
+    !modal_or_event && !blank
+}
+
+fn check_kept_lines(
+    orig: &Program,
+    opt: &Program,
+    order: &[Placement],
+    rewritten: &[bool],
+    dialect: &Dialect,
+) -> Result<(), VerifyError> {
+    let mut have: HashMap<&str, usize> = HashMap::new();
+    for l in &opt.lines {
+        *have.entry(l.trim_end_matches('\r')).or_default() += 1;
+    }
+    let mut need: Vec<(usize, String)> = Vec::new();
+    for j in (0..orig.header_end).chain(orig.footer_start..orig.lines.len()) {
+        need.push((j, orig.lines[j].clone()));
+    }
+    for course in &orig.courses {
+        for item in course.pre_before.iter().chain(&course.pre_after).chain(&course.post) {
+            match item {
+                Item::Line(j) => need.push((*j, orig.lines[*j].clone())),
+                Item::Kept(j, t) => need.push((*j, t.clone())),
+            }
+        }
+    }
+    for (p, _) in order.iter().zip(rewritten).filter(|(_, r)| **r) {
+        for j in orig.courses[p.course].span.clone() {
+            if orig.line_segment[j].is_none() && must_keep(&orig.lines[j], dialect) {
+                need.push((j, orig.lines[j].clone()));
+            }
+        }
+    }
+    for (j, text) in need {
+        let t = text.trim_end_matches('\r');
+        match have.get_mut(t) {
+            Some(n) if *n > 0 => *n -= 1,
+            _ => return Err(VerifyError::LostLine { line: j + 1, text: t.to_string() }),
+        }
+    }
+    Ok(())
+}
+
+/// The header and the footer must be there, line for line, at the start and the end.
+fn check_header_footer(orig: &Program, opt: &Program) -> Result<(), VerifyError> {
+    let same = |a: &str, b: &str| a.trim_end_matches('\r') == b.trim_end_matches('\r');
+    for j in 0..orig.header_end {
+        if !opt.lines.get(j).is_some_and(|l| same(l, &orig.lines[j])) {
+            return Err(VerifyError::LostLine { line: j + 1, text: orig.lines[j].clone() });
+        }
+    }
+    let footer_len = orig.lines.len() - orig.footer_start;
+    if opt.lines.len() < footer_len + orig.header_end {
+        let j = orig.footer_start.min(orig.lines.len().saturating_sub(1));
+        return Err(VerifyError::LostLine { line: j + 1, text: orig.lines.get(j).cloned().unwrap_or_default() });
+    }
+    let off = opt.lines.len() - footer_len;
+    for j in 0..footer_len {
+        if !same(&opt.lines[off + j], &orig.lines[orig.footer_start + j]) {
+            let line = orig.footer_start + j;
+            return Err(VerifyError::LostLine { line: line + 1, text: orig.lines[line].clone() });
+        }
+    }
+    Ok(())
+}
+
+/// Sweeps the courses in their new order over a grid of the courses laid so far: a course
+/// laid before an overlapping course of an earlier ply is a violation.
+fn check_precedence(orig: &Program, fps: &Footprints, order: &[Placement]) -> Result<(), VerifyError> {
+    let mut widths: Vec<f64> = fps.courses.iter().flat_map(|f| f.quads.iter().map(|q| q.hw)).collect();
+    widths.sort_by(f64::total_cmp);
+    let cell = widths.get(widths.len() / 2).map_or(10.0, |w| (8.0 * w).max(1e-2));
+    let period = fps.frame.period();
+    let rows = period.map(|p| ((p / cell).ceil().max(1.0)) as i64);
+    let hcell = match (period, rows) {
+        (Some(p), Some(r)) => p / r as f64,
+        _ => cell,
+    };
+    // cell -> (max ply laid, entries (course, quad))
+    type Cell = (usize, Vec<(u32, u32)>);
+    let mut grid: HashMap<(i64, i64), Cell> = HashMap::new();
+    let key = |i: i64, j: i64| match rows {
+        Some(r) => (i, j.rem_euclid(r)),
+        None => (i, j),
+    };
+    for p in order {
+        let b = p.course;
+        let pb = orig.courses[b].ply;
+        for (qi, q) in fps.courses[b].quads.iter().enumerate() {
+            let (lo, hi) = q.bounds();
+            let (i0, i1) = ((lo[0] / cell).floor() as i64, (hi[0] / cell).floor() as i64);
+            let (j0, j1) = ((lo[1] / hcell).floor() as i64, (hi[1] / hcell).floor() as i64);
+            for i in i0..=i1 {
+                for j in j0..=j1 {
+                    let entry = grid.entry(key(i, j)).or_insert((0, Vec::new()));
+                    if entry.0 > pb {
+                        for &(x, qx) in &entry.1 {
+                            let px = orig.courses[x as usize].ply;
+                            if px > pb
+                                && crate::precedence::quads_overlap(
+                                    &fps.frame,
+                                    q,
+                                    &fps.courses[x as usize].quads[qx as usize],
+                                )
+                            {
+                                return Err(VerifyError::Precedence {
+                                    before: orig.course_name(b),
+                                    after: orig.course_name(x as usize),
+                                });
+                            }
+                        }
+                    }
+                    entry.0 = entry.0.max(pb);
+                    entry.1.push((b as u32, qi as u32));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Motion of a program under every cost model the machine supports; `course_of[c]` maps the
+/// program's course c to the index it is reported under. Lines before `header_end` and from
+/// `footer_start` count as header and footer.
+pub fn measure(
+    p: &Program,
+    machine: &Machine,
+    course_of: &[usize],
+    header_end: usize,
+    footer_start: usize,
+) -> Vec<Motion> {
+    let mut regions = p.regions();
+    for (j, r) in regions.iter_mut().enumerate() {
+        if j < header_end {
+            *r = Region::Header;
+        } else if j >= footer_start {
+            *r = Region::Footer;
+        }
+    }
+    let mut out = Vec::new();
+    for kind in CostKind::ALL {
+        let Ok(cost) = MachineCost::new(machine.clone(), kind, StateTable::new(machine.dim())) else {
+            continue;
+        };
+        let mut m = Motion { kind, off_course: vec![0.0; p.courses.len()], off_other: 0.0, on_part: 0.0 };
+        let mut d = vec![0.0; machine.dim()];
+        for s in &p.segments {
+            let (a, b) = (p.point(s.from), p.point(s.to));
+            for i in 0..d.len() {
+                d[i] = b[i] - a[i];
+            }
+            let c = cost.segment(a, b, &d);
+            if s.on_part {
+                m.on_part += c;
+                continue;
+            }
+            match regions[s.line as usize] {
+                Region::Middle(k) | Region::Approach(k) | Region::OnPart(k) | Region::Retract(k) => {
+                    m.off_course[course_of[k]] += c
+                }
+                Region::Header | Region::Footer => m.off_other += c,
+            }
+        }
+        out.push(m);
+    }
+    out
+}

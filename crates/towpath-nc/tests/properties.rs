@@ -1,0 +1,323 @@
+//! Property tests over generated programs: exact round trips; any feasible order, with any
+//! legal reversals, rewrites into a program the independent verifier accepts and whose
+//! measured off-part motion is the solver's route cost; the optimizer never returns a dearer
+//! program; the parser never panics.
+
+use proptest::prelude::*;
+use towpath_machine::{Axis, AxisKind, CostKind, Machine};
+use towpath_nc::{
+    build_problem, optimize, parse, reverse_course, rewrite, verify, AfpOptions, Dialect, OptimizeOptions, Placement,
+    VerifyOptions, Width,
+};
+use towpath_seq::{check, Step, TaskId};
+
+fn machine() -> Machine {
+    let mut c = Axis::new("C", AxisKind::Continuous);
+    c.heading = true;
+    c.weight = 0.2;
+    let mut axes =
+        vec![Axis::new("X", AxisKind::Linear), Axis::new("Y", AxisKind::Linear), Axis::new("Z", AxisKind::Linear), c];
+    for a in &mut axes {
+        a.max_velocity = Some(400.0);
+        a.max_acceleration = Some(800.0);
+    }
+    Machine::new("prop", axes).unwrap()
+}
+
+#[derive(Clone, Debug)]
+struct CourseSpec {
+    x: f64,
+    y: f64,
+    angle: f64,
+    len: f64,
+    points: usize,
+    heading: f64,
+    mask: u64,
+    mid_cut: Option<(usize, u64)>,
+    extra: u8,
+}
+
+#[derive(Clone, Debug)]
+struct PartSpec {
+    plies: Vec<Vec<CourseSpec>>,
+    course_markers: bool,
+    crlf: bool,
+    final_newline: bool,
+}
+
+fn course_spec() -> impl Strategy<Value = CourseSpec> {
+    (
+        (0.0f64..300.0, 0.0f64..300.0, 0.0f64..std::f64::consts::TAU, 20.0f64..250.0),
+        (1usize..5, 0u32..3600, 1u64..16, proptest::option::of((0usize..4, 1u64..16)), 0u8..4),
+    )
+        .prop_map(|((x, y, angle, len), (points, h, mask, mid, extra))| CourseSpec {
+            x: (x * 1000.0).round() / 1000.0,
+            y: (y * 1000.0).round() / 1000.0,
+            angle,
+            len,
+            points,
+            heading: h as f64 / 10.0,
+            mask,
+            // A cut of some (not all) of the tows on, at an inner point.
+            mid_cut: mid.and_then(|(at, cut)| {
+                let c = cut & mask;
+                (points > 1 && c != 0 && c != mask).then(|| (1 + at % (points - 1), c))
+            }),
+            extra,
+        })
+}
+
+fn part_spec() -> impl Strategy<Value = PartSpec> {
+    (
+        proptest::collection::vec(proptest::collection::vec(course_spec(), 1..5), 1..4),
+        any::<bool>(),
+        any::<bool>(),
+        any::<bool>(),
+    )
+        .prop_map(|(plies, course_markers, crlf, final_newline)| PartSpec {
+            plies,
+            course_markers,
+            crlf,
+            final_newline,
+        })
+}
+
+fn n(v: f64) -> String {
+    let s = format!("{v:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.').to_string();
+    if s == "-0" {
+        "0".into()
+    } else {
+        s
+    }
+}
+
+fn program(spec: &PartSpec) -> String {
+    let mut l: Vec<String> = vec!["%".into(), "(generated part)".into(), "G21 G90".into(), "G0 Z100".into()];
+    for (pi, ply) in spec.plies.iter().enumerate() {
+        l.push(format!("(PLY {} generated)", pi + 1));
+        for (ci, c) in ply.iter().enumerate() {
+            if spec.course_markers {
+                l.push(format!("(COURSE {})", ci + 1));
+            }
+            let pt = |k: usize| {
+                let t = c.len * k as f64 / c.points as f64;
+                (c.x + t * c.angle.cos(), c.y + t * c.angle.sin())
+            };
+            let (x0, y0) = pt(0);
+            l.push(format!("G0 X{} Y{} Z20 C{}", n(x0), n(y0), n(c.heading)));
+            if c.extra == 1 {
+                l.push("M8 (heater)".into());
+            }
+            l.push("G1 Z0 F1000".into());
+            l.push("M20".into());
+            l.push(format!("M60 P{}", c.mask));
+            let mut on = c.mask;
+            for k in 1..=c.points {
+                let (x, y) = pt(k);
+                let feed = if k == 1 { " F2500" } else { "" };
+                let comment = if c.extra == 2 && k == 1 { " (first move)" } else { "" };
+                l.push(format!("G1 X{} Y{}{feed}{comment}", n(x), n(y)));
+                if let Some((at, cut)) = c.mid_cut {
+                    if at == k {
+                        l.push(format!("M61 P{cut}"));
+                        on &= !cut;
+                    }
+                }
+                if c.extra == 3 && k == 1 {
+                    l.push("(a note inside the course)".into());
+                }
+            }
+            l.push(format!("M61 P{on}"));
+            l.push("M21".into());
+            l.push("G1 Z20".into());
+        }
+    }
+    l.push("G0 Z100".into());
+    l.push("M30".into());
+    let sep = if spec.crlf { "\r\n" } else { "\n" };
+    let mut s = l.join(sep);
+    if spec.final_newline {
+        s.push_str(sep);
+    }
+    s
+}
+
+/// A random feasible order with random reversals.
+fn random_order(k: usize, prec: &towpath_seq::Precedence, rev_ok: &[bool], seed: u64) -> Vec<Placement> {
+    let mut state = seed | 1;
+    let mut rnd = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let mut indeg: Vec<usize> = (0..k).map(|t| prec.predecessors(TaskId(t as u32)).len()).collect();
+    let mut ready: Vec<usize> = (0..k).filter(|&t| indeg[t] == 0).collect();
+    let mut out = Vec::new();
+    while !ready.is_empty() {
+        let i = (rnd() % ready.len() as u64) as usize;
+        let t = ready.swap_remove(i);
+        out.push(Placement { course: t, reversed: rev_ok[t] && rnd() % 2 == 0 });
+        for s in prec.successors(TaskId(t as u32)) {
+            indeg[s.index()] -= 1;
+            if indeg[s.index()] == 0 {
+                ready.push(s.index());
+            }
+        }
+    }
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(40),
+        ..ProptestConfig::default()
+    })]
+
+    #[test]
+    fn round_trip_is_exact(spec in part_spec()) {
+        let text = program(&spec);
+        let d = Dialect::default();
+        let p = parse(&text, &machine(), &d).unwrap();
+        prop_assert_eq!(p.courses.len(), spec.plies.iter().map(Vec::len).sum::<usize>());
+        let order: Vec<Placement> = (0..p.courses.len()).map(|c| Placement { course: c, reversed: false }).collect();
+        prop_assert_eq!(rewrite(&p, &order, &machine(), &d, &[]).unwrap(), text);
+    }
+
+    #[test]
+    fn any_feasible_order_verifies_and_costs_what_the_solver_thinks(spec in part_spec(), seed in any::<u64>()) {
+        let text = program(&spec);
+        let d = Dialect::default();
+        let m = machine();
+        let p = parse(&text, &m, &d).unwrap();
+        let opts = AfpOptions { bidirectional: true, width: Some(Width::Tow(6.0)), cost: CostKind::Axis, ..AfpOptions::default() };
+        let afp = build_problem(&p, &m, &d, &opts).unwrap();
+        let rev_ok: Vec<bool> = (0..p.courses.len()).map(|c| afp.reversed[c].is_some()).collect();
+        prop_assert!(rev_ok.iter().all(|&r| r));
+        let order = random_order(p.courses.len(), afp.problem.precedence(), &rev_ok, seed);
+        let steps: Vec<Step> = order.iter().map(|pl| Step { task: TaskId(pl.course as u32), mode: pl.reversed as u32 }).collect();
+        let route = check(&afp.problem, &steps).unwrap();
+        let out = rewrite(&p, &order, &m, &d, &afp.reversed).unwrap();
+        let v = verify(&text, &out, &m, &d, &VerifyOptions { width: Some(Width::Tow(6.0)), ..VerifyOptions::default() }).unwrap();
+        prop_assert_eq!(&v.order, &order);
+        let identity = order.iter().enumerate().all(|(i, pl)| pl.course == i && !pl.reversed);
+        let (b, a) = v.motion(CostKind::Axis).unwrap();
+        prop_assert!((a.on_part - b.on_part).abs() <= 1e-6 * (1.0 + b.on_part));
+        if !identity {
+            let measured: f64 = a.off_course.iter().sum();
+            prop_assert!((measured - route).abs() <= 1e-6 * (1.0 + route), "measured {} route {}", measured, route);
+        }
+        // A reversed course reversed again is the original course.
+        for c in 0..p.courses.len() {
+            let r = reverse_course(&p, c, &m, &d).unwrap();
+            prop_assert!(r.shift.abs() == 180.0);
+        }
+    }
+
+    #[test]
+    fn optimizer_never_returns_a_dearer_program(spec in part_spec(), bi in any::<bool>()) {
+        let text = program(&spec);
+        let d = Dialect::default();
+        let opts = OptimizeOptions {
+            afp: AfpOptions { bidirectional: bi, width: Some(Width::Tow(6.0)), ..AfpOptions::default() },
+            time_limit: None,
+            iterations: Some(200),
+            threads: 1,
+            ..OptimizeOptions::default()
+        };
+        let o = optimize(&text, &machine(), &d, &opts).unwrap();
+        let (b, a) = o.verification.motion(CostKind::Axis).unwrap();
+        prop_assert!(a.off_part() <= b.off_part() * (1.0 + 1e-12) + 1e-9);
+        if o.fell_back {
+            prop_assert_eq!(o.text, text);
+        }
+    }
+
+    #[test]
+    fn optimizing_the_output_again_still_verifies_against_the_original(spec in part_spec()) {
+        let text = program(&spec);
+        let d = Dialect::default();
+        let opts = |seed| OptimizeOptions {
+            afp: AfpOptions { bidirectional: true, width: Some(Width::Tow(6.0)), ..AfpOptions::default() },
+            time_limit: None,
+            iterations: Some(100),
+            threads: 1,
+            seed,
+            ..OptimizeOptions::default()
+        };
+        let once = optimize(&text, &machine(), &d, &opts(1)).unwrap();
+        // Read again, the output's plies each hold courses of one original ply.
+        let reread = parse(&once.text, &machine(), &d).unwrap();
+        for ply in &reread.plies {
+            let origin: std::collections::BTreeSet<usize> =
+                ply.courses.iter().map(|&k| once.program.courses[once.order[k].course].ply).collect();
+            prop_assert!(origin.len() <= 1, "{:?}", origin);
+        }
+        let twice = optimize(&once.text, &machine(), &d, &opts(2)).unwrap();
+        let v = verify(&text, &twice.text, &machine(), &d, &VerifyOptions { width: Some(Width::Tow(6.0)), ..VerifyOptions::default() });
+        prop_assert!(v.is_ok(), "{:?}", v.err());
+    }
+
+    #[test]
+    fn verifier_never_panics_on_mutated_output(spec in part_spec(), edits in proptest::collection::vec((0usize..10_000, 0u8..4, any::<char>()), 1..4)) {
+        let text = program(&spec);
+        let d = Dialect::default();
+        let opts = OptimizeOptions {
+            afp: AfpOptions { bidirectional: true, width: Some(Width::Tow(6.0)), ..AfpOptions::default() },
+            time_limit: None,
+            iterations: Some(50),
+            threads: 1,
+            ..OptimizeOptions::default()
+        };
+        let out = optimize(&text, &machine(), &d, &opts).unwrap().text;
+        let mut lines: Vec<String> = out.lines().map(str::to_string).collect();
+        for (at, kind, ch) in edits {
+            if lines.is_empty() {
+                break;
+            }
+            let i = at % lines.len();
+            match kind {
+                0 => { lines.remove(i); }
+                1 => { let l = lines[i].clone(); lines.insert(i, l); }
+                2 => { if i + 1 < lines.len() { lines.swap(i, i + 1); } }
+                _ => { let mut l: Vec<char> = lines[i].chars().collect(); let k = at % (l.len() + 1); l.insert(k, ch); lines[i] = l.into_iter().collect(); }
+            }
+        }
+        let mutated = lines.join("\n");
+        let r = verify(&text, &mutated, &machine(), &d, &VerifyOptions { width: Some(Width::Tow(6.0)), ..VerifyOptions::default() });
+        // Removing or duplicating a line of motion is always caught.
+        if r.is_ok() {
+            let p = parse(&mutated, &machine(), &d).unwrap();
+            prop_assert_eq!(p.courses.len(), spec.plies.iter().map(Vec::len).sum::<usize>());
+        }
+    }
+
+    #[test]
+    fn parser_never_panics_on_line_soup(lines in proptest::collection::vec(
+        prop_oneof![
+            Just("G0 X10 Y10 Z5 C0".to_string()),
+            Just("G1 X20 F100".to_string()),
+            Just("M20".to_string()), Just("M21".to_string()),
+            Just("M60 P3".to_string()), Just("M61 P3".to_string()), Just("M61 P1".to_string()),
+            Just("(PLY 1)".to_string()), Just("(COURSE 2)".to_string()),
+            Just("G91".to_string()), Just("G90".to_string()), Just("G92 C10".to_string()),
+            Just("X-5".to_string()), Just("%".to_string()), Just("G2 X1".to_string()),
+            "[ -~]{0,20}",
+        ], 0..40)) {
+        let text = lines.join("\n");
+        let d = Dialect::default();
+        if let Ok(p) = parse(&text, &machine(), &d) {
+            let order: Vec<Placement> = (0..p.courses.len()).map(|c| Placement { course: c, reversed: false }).collect();
+            prop_assert_eq!(rewrite(&p, &order, &machine(), &d, &[]).unwrap(), text.clone());
+            for c in 0..p.courses.len() {
+                let _ = reverse_course(&p, c, &machine(), &d);
+            }
+        }
+    }
+
+    #[test]
+    fn parser_never_panics_on_any_text(text in "\\PC{0,300}") {
+        let _ = parse(&text, &machine(), &Dialect::default());
+    }
+}

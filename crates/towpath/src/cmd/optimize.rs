@@ -1,0 +1,141 @@
+//! `towpath optimize`: an AFP program in, the same part with less off-part motion out, verified.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use towpath_machine::CostKind;
+use towpath_nc::{optimize, AfpOptions, NcError, OptimizeOptions, PrecedenceRule, Report};
+
+use super::afp_common::{read, write, MachineArgs};
+use crate::exit;
+
+/// Arguments of `towpath optimize`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The qualified AFP program (CNC program with plies of courses).
+    #[arg(value_name = "PROGRAM")]
+    pub program: PathBuf,
+    #[command(flatten)]
+    pub machine: MachineArgs,
+    /// Allow courses to be laid in reverse (heading turned 180°, tow restarts and cuts swapped).
+    #[arg(long)]
+    pub bidirectional: bool,
+    /// Cost of off-part moves: weighted axis distance (seed 000), motion time, or tool-point
+    /// distance.
+    #[arg(long, default_value = "axis", value_name = "axis|time|tool")]
+    pub cost: CostKind,
+    /// Precedence: a course after the courses of earlier plies it overlaps (courses), seed 000's
+    /// precedence sets (sets), or ply by ply (plies, needs no widths).
+    #[arg(long, default_value = "courses", value_name = "courses|sets|plies")]
+    pub precedence: PrecedenceRule,
+    /// Keep the order of the courses within each ply.
+    #[arg(long)]
+    pub keep_ply_order: bool,
+    /// Solver time limit in seconds (default: 1 s plus 0.2 ms per course, at most 10 s).
+    #[arg(long, value_name = "S")]
+    pub time_limit: Option<f64>,
+    /// Solver seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Solver threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Where to write the optimized program.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Write a report: `.json` for data, `.html` for a page with a before/after plan view.
+    #[arg(long, value_name = "REPORT.json|html")]
+    pub report: Option<PathBuf>,
+    /// Print the report as one JSON object on stdout instead of a summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Maps an optimization error to an exit code, naming the program file.
+pub fn classify(file: &std::path::Path, e: NcError) -> anyhow::Error {
+    match e {
+        NcError::SelfCheck(_) => exit::check_failed(anyhow::anyhow!("{}: {e}", file.display())),
+        _ => exit::bad_input(anyhow::anyhow!("{}: {e}", file.display())),
+    }
+}
+
+/// Runs `towpath optimize`.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    if let Some(t) = args.time_limit {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(exit::bad_input(anyhow::anyhow!("--time-limit {t}: give a number of seconds ≥ 0")));
+        }
+    }
+    let (machine, dialect, width) = args.machine.load()?;
+    let text = read(&args.program)?;
+    let afp = AfpOptions {
+        cost: args.cost,
+        bidirectional: args.bidirectional,
+        precedence: args.precedence,
+        keep_ply_order: args.keep_ply_order,
+        width,
+    };
+    // The course count decides the default time limit; count roller contacts cheaply.
+    let time_limit = match args.time_limit {
+        Some(t) => Duration::from_secs_f64(t),
+        None => {
+            let courses = text.lines().filter(|l| l.contains(dialect.contact_on.as_str())).count().max(1);
+            towpath_nc::auto_time_limit(if dialect.contact_on.is_empty() { 1000 } else { courses })
+        }
+    };
+    let bar = progress_bar(time_limit);
+    let opts = OptimizeOptions {
+        afp: afp.clone(),
+        time_limit: Some(time_limit),
+        seed: args.seed,
+        threads: args.threads.unwrap_or_else(|| OptimizeOptions::default().threads),
+        progress: bar.clone().map(|b| {
+            let f: towpath_seq::ProgressFn = std::sync::Arc::new(move |p: &towpath_seq::Progress| {
+                b.set_position((p.fraction * 1000.0) as u64);
+                b.set_message(format!("best {:.1}", p.best_cost));
+            });
+            f
+        }),
+        ..OptimizeOptions::default()
+    };
+    let o = optimize(&text, &machine, &dialect, &opts).map_err(|e| classify(&args.program, e));
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let o = o?;
+    write(&args.output, &o.text)?;
+    let name =
+        args.program.file_name().map_or_else(|| args.program.display().to_string(), |n| n.to_string_lossy().into());
+    let report = Report::new(&name, &machine, &o, &afp);
+    if let Some(path) = &args.report {
+        let body = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("html") || e.eq_ignore_ascii_case("htm"))
+        {
+            let optimized = towpath_nc::parse(&o.text, &machine, &dialect).map_err(|e| classify(&args.output, e))?;
+            report.to_html(&o, &optimized, &machine)
+        } else {
+            serde_json::to_string_pretty(&report)?
+        };
+        write(path, &body)?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print!("{}", report.summary());
+        println!("  written to {}", args.output.display());
+    }
+    Ok(())
+}
+
+/// A progress bar on stderr, only when it is a terminal.
+fn progress_bar(limit: Duration) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let b = indicatif::ProgressBar::new(1000);
+    let style = indicatif::ProgressStyle::with_template("sequencing {bar:30} {msg} ({elapsed} of ~{prefix})")
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+    b.set_style(style);
+    b.set_prefix(format!("{:.0}s", limit.as_secs_f64()));
+    Some(b)
+}

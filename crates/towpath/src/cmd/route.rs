@@ -1,0 +1,152 @@
+//! `towpath route`: the open rural postman job of seed 004. Reads a travel graph with required
+//! edges (JSON), orders and orients the required edges so that the connecting travel along
+//! shortest paths is least, and writes the full vertex walk.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::Context;
+use towpath_baselines::{solve_with, BaselineError, SolverName};
+use towpath_coverage::{read_instance, seed004_like, verify_route, write_instance, Instance, RouteJson, RppModel};
+use towpath_seq::SolveOptions;
+
+use crate::cmd::solver_args::SolverArgs;
+use crate::exit;
+
+/// Arguments of `towpath route`.
+#[derive(clap::Args, Debug)]
+#[command(after_long_help = "Integrates separate tool paths into one open route (seed 004's open rural postman \
+problem). The input is a travel graph in JSON: vertices with coordinates, undirected edges with lengths, \
+some edges marked \"required\" (each a tool path to be done once, in either direction). The tool travels \
+between required edges along shortest paths. The output is the full vertex walk, including connecting paths.
+
+Input format (towpath-rpp/1):
+  {\"vertices\": [[x, y], ...], \"edges\": [{\"a\": 0, \"b\": 1, \"required\": true, \"length\": 1.5}, ...],
+   \"start\": 0}
+(length defaults to the straight-line distance; start is optional.)")]
+pub struct Args {
+    /// The travel graph (JSON). Omit with --generate.
+    #[arg(value_name = "GRAPH.json", required_unless_present = "generate")]
+    pub graph: Option<PathBuf>,
+    /// Instead of reading a file, generate an instance shaped like seed 004's sample data with
+    /// this many required edges (and twice as many vertices).
+    #[arg(long, value_name = "R", conflicts_with = "graph")]
+    pub generate: Option<usize>,
+    /// Seed of the generated instance.
+    #[arg(long, default_value_t = 1, requires = "generate")]
+    pub generate_seed: u64,
+    /// Write the instance (read or generated) to this JSON file.
+    #[arg(long, value_name = "FILE")]
+    pub save_instance: Option<PathBuf>,
+    /// Time limit for the solver, in seconds (the seed papers' solvers run their own budgets and
+    /// stop early only if this passes).
+    #[arg(long, default_value_t = 10.0)]
+    pub time_limit: f64,
+    /// Seed for the solver's random choices (same seed, same answer under a work budget).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Solver threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Write the route (JSON) to this file.
+    #[arg(short, long, value_name = "ROUTE.json")]
+    pub output: Option<PathBuf>,
+    /// Print one JSON object (the route) instead of a summary.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub solver: SolverArgs,
+}
+
+/// Runs `towpath route`.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let instance = load(&args)?;
+    if let Some(path) = &args.save_instance {
+        std::fs::write(path, write_instance(&instance)).with_context(|| format!("writing {}", path.display()))?;
+    }
+    let model = RppModel::new(instance).map_err(exit::bad_input)?;
+    let mut opts = SolveOptions {
+        time_limit: Some(Duration::from_secs_f64(args.time_limit.max(0.0))),
+        seed: args.seed,
+        ..SolveOptions::default()
+    };
+    if let Some(t) = args.threads {
+        opts.threads = t.max(1);
+    }
+    let name = args.solver.solver;
+    // A progress bar on stderr for the time-limited searches, only on a terminal.
+    let bar =
+        (std::io::stderr().is_terminal() && matches!(name, SolverName::Towpath | SolverName::Castelino)).then(|| {
+            let bar = indicatif::ProgressBar::new(1000);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template("{spinner} {wide_bar} {elapsed_precise} {msg}")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            bar
+        });
+    if let Some(bar) = &bar {
+        let bar = bar.clone();
+        opts.progress = Some(Arc::new(move |p: &towpath_seq::Progress| {
+            bar.set_position((p.fraction * 1000.0) as u64);
+            bar.set_message(format!("best {:.3}", p.best_cost));
+        }));
+    }
+    let report = solve_with(name, model.problem(), &opts, &args.solver.params()).map_err(|e| match e {
+        BaselineError::BadParams(_)
+        | BaselineError::TooLarge { .. }
+        | BaselineError::Unsupported { .. }
+        | BaselineError::BadSets(_) => exit::bad_input(e),
+        // the instance is validated: any other failure is the solver's
+        e => anyhow::Error::new(e).context(format!("solver {name} failed")),
+    })?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    let route = model.route(&report.solution.steps).map_err(exit::check_failed)?;
+    let length = verify_route(model.instance(), &route).map_err(exit::check_failed)?;
+    let out = RouteJson::new(model.instance(), &route, name.as_str(), report.elapsed.as_secs_f64());
+    if let Some(path) = &args.output {
+        let text = serde_json::to_string_pretty(&out)?;
+        std::fs::write(path, text + "\n").with_context(|| format!("writing {}", path.display()))?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&out)?);
+    } else {
+        let i = model.instance();
+        println!("towpath route: {}", i.name().unwrap_or("(unnamed)"));
+        println!(
+            "  graph              : {} vertices, {} edges, {} required",
+            i.vertices().len(),
+            i.edges().len(),
+            i.required().len()
+        );
+        println!("  solver             : {name} — {}", name.reference());
+        println!("  path length        : {length:>12.3}");
+        println!("  required edges     : {:>12.3}", out.required_length);
+        println!("  connecting travel  : {:>12.3}", out.deadhead_length);
+        println!("  vertices on walk   : {:>12}", route.vertices.len());
+        println!("  solver time        : {:>12.3} s", report.elapsed.as_secs_f64());
+        if let Some(path) = &args.output {
+            println!("  route written to   : {}", path.display());
+        }
+    }
+    Ok(())
+}
+
+fn load(args: &Args) -> anyhow::Result<Instance> {
+    if let Some(r) = args.generate {
+        if r == 0 {
+            return Err(exit::bad_input(anyhow::anyhow!("--generate needs at least 1 required edge")));
+        }
+        return Ok(seed004_like(r, args.generate_seed));
+    }
+    let Some(path) = &args.graph else {
+        return Err(exit::bad_input(anyhow::anyhow!("give a GRAPH.json file or --generate R")));
+    };
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading {}", path.display()))
+        .map_err(exit::bad_input)?;
+    read_instance(&text).map_err(|e| exit::bad_input(anyhow::anyhow!("{}: {e}", path.display())))
+}

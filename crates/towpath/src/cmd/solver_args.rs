@@ -1,0 +1,45 @@
+//! `--solver NAME` and the baselines' parameters, shared by every command that sequences
+//! (flatten [`SolverArgs`] into a command's `Args`).
+
+use towpath_baselines::{AcoParams, BaselineParams, DohertyParams, GaParams, SolverName};
+
+/// Which solver sequences the tasks, and the parameters of the seed papers' solvers.
+#[derive(clap::Args, Debug, Clone)]
+pub struct SolverArgs {
+    /// The solver: towpath (towpath's own, the best), or one of the seed papers' algorithms for
+    /// comparison: doherty (seed 000 §3.2), castelino (seed 003, GTSP→TSP transformation),
+    /// ga (seed 004 §IV), aco1 / aco2 (seed 004 §V, one or two ants per task; aco = aco2).
+    #[arg(long, value_enum, default_value_t = SolverName::Towpath, help_heading = "Solver")]
+    pub solver: SolverName,
+    /// GA: generations (paper: 100 is enough for most sizes; Table I used 1000).
+    #[arg(long, default_value_t = 100, help_heading = "Solver")]
+    pub ga_generations: usize,
+    /// GA: population size P_size (paper: 100; Table I used 200).
+    #[arg(long, default_value_t = 100, help_heading = "Solver")]
+    pub ga_population: usize,
+    /// ACO: cycles (paper: 10).
+    #[arg(long, default_value_t = 10, help_heading = "Solver")]
+    pub aco_cycles: usize,
+    /// Doherty: N, depth-first iterations without improvement before stopping.
+    #[arg(long, default_value_t = 3, help_heading = "Solver")]
+    pub doherty_n: usize,
+    /// Doherty: maximum depth-first iterations per precedence set.
+    #[arg(long, default_value_t = 25, help_heading = "Solver")]
+    pub doherty_max_iterations: usize,
+}
+
+impl SolverArgs {
+    /// The parameters of the baselines as set on the command line.
+    pub fn params(&self) -> BaselineParams {
+        BaselineParams {
+            ga: GaParams { generations: self.ga_generations, population: self.ga_population, ..GaParams::default() },
+            aco: AcoParams { cycles: self.aco_cycles, ..AcoParams::default() },
+            doherty: DohertyParams {
+                no_improvement: self.doherty_n,
+                max_iterations: self.doherty_max_iterations,
+                ..DohertyParams::default()
+            },
+            ..BaselineParams::default()
+        }
+    }
+}

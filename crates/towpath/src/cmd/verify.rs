@@ -1,0 +1,85 @@
+//! `towpath verify`: checks an optimized AFP program against its original, independently of the
+//! optimizer, and prints the off-part motion before and after.
+
+use std::path::PathBuf;
+
+use towpath_nc::{totals, verify, VerifyError, VerifyOptions};
+
+use super::afp_common::{read, MachineArgs};
+use crate::exit;
+
+/// Arguments of `towpath verify`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The original program.
+    #[arg(value_name = "ORIGINAL")]
+    pub original: PathBuf,
+    /// The optimized program.
+    #[arg(value_name = "OPTIMIZED")]
+    pub optimized: PathBuf,
+    #[command(flatten)]
+    pub machine: MachineArgs,
+    /// Also require every ply to be finished before the next one starts.
+    #[arg(long)]
+    pub strict_plies: bool,
+    /// Also require the courses of each ply in their original order.
+    #[arg(long)]
+    pub keep_ply_order: bool,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `towpath verify`.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let (machine, dialect, width) = args.machine.load()?;
+    let original = read(&args.original)?;
+    let optimized = read(&args.optimized)?;
+    let opts = VerifyOptions { width, strict_plies: args.strict_plies, keep_ply_order: args.keep_ply_order };
+    let v = verify(&original, &optimized, &machine, &dialect, &opts).map_err(|e| match e {
+        VerifyError::Original(e) => exit::bad_input(anyhow::anyhow!("{}: {e}", args.original.display())),
+        VerifyError::Optimized(e) => exit::bad_input(anyhow::anyhow!("{}: {e}", args.optimized.display())),
+        VerifyError::Setup(e) => exit::bad_input(anyhow::anyhow!("{e}")),
+        e => {
+            exit::check_failed(anyhow::anyhow!("{} against {}: {e}", args.optimized.display(), args.original.display()))
+        }
+    })?;
+    let t = totals(&v);
+    if args.json {
+        println!(
+            "{}",
+            serde_json::json!({
+                "verified": true,
+                "courses": v.courses,
+                "reversed": v.reversed,
+                "precedence_checked": v.precedence_checked,
+                "totals": t,
+            })
+        );
+        return Ok(());
+    }
+    println!(
+        "verified: {} courses, same motion on-part ({} laid in reverse), precedence {}",
+        v.courses,
+        v.reversed,
+        if v.precedence_checked { "kept" } else { "not needed (one ply)" }
+    );
+    println!(
+        "  {:<6} {:>14} {:>14} {:>8} {:>14} {:>14} {:>8}",
+        "cost", "off-part in", "off-part out", "saved", "total in", "total out", "saved"
+    );
+    for x in &t {
+        println!(
+            "  {:<6} {:>14.1} {:>14.1} {:>7.1}% {:>14.1} {:>14.1} {:>7.1}%   ({})",
+            x.kind.name(),
+            x.off_before,
+            x.off_after,
+            x.off_saved_percent,
+            x.total_before,
+            x.total_after,
+            x.total_saved_percent,
+            x.unit
+        );
+    }
+    Ok(())
+}

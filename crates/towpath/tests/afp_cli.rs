@@ -1,0 +1,139 @@
+//! The AFP subcommands end to end: `demo`, `optimize`, `verify`, their exit codes and messages.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn towpath() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_towpath"))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("towpath-afp-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(cmd: &mut Command) -> (i32, String, String) {
+    let out = cmd.output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn demo(dir: &Path) {
+    let (code, out, err) = run(towpath().args(["demo", "--time-limit", "0.05", "--dir"]).arg(dir));
+    assert_eq!(code, 0, "{out}\n{err}");
+    assert!(out.contains("planar-45") && out.contains("cylinder-base-3-pads"), "{out}");
+}
+
+#[test]
+fn demo_optimize_verify_round() {
+    let d = temp_dir("round");
+    demo(&d);
+    for f in
+        ["gantry-afp.toml", "mandrel-afp.toml", "dialect.toml", "planar-45.nc", "planar-45.opt.nc", "planar-45.html"]
+    {
+        assert!(d.join(f).exists(), "{f} missing");
+    }
+    let out = d.join("p45.nc");
+    let report = d.join("p45.json");
+    let (code, stdout, err) = run(towpath()
+        .arg("optimize")
+        .arg(d.join("planar-45.nc"))
+        .arg("--machine")
+        .arg(d.join("gantry-afp.toml"))
+        .arg("--dialect")
+        .arg(d.join("dialect.toml"))
+        .args(["--bidirectional", "--cost", "time", "--time-limit", "0.2", "--json", "-o"])
+        .arg(&out)
+        .arg("--report")
+        .arg(&report));
+    assert_eq!(code, 0, "{err}");
+    let json: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(json["courses"], 49);
+    assert_eq!(json["cost"], "time");
+    let time = json["totals"].as_array().unwrap().iter().find(|t| t["kind"] == "time").unwrap();
+    assert!(time["off_after"].as_f64().unwrap() < time["off_before"].as_f64().unwrap());
+    assert!(std::fs::read_to_string(&report).unwrap().contains("\"per_set\""));
+
+    let (code, stdout, err) = run(towpath()
+        .arg("verify")
+        .arg(d.join("planar-45.nc"))
+        .arg(&out)
+        .arg("--machine")
+        .arg(d.join("gantry-afp.toml"))
+        .arg("--dialect")
+        .arg(d.join("dialect.toml")));
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.starts_with("verified: 49 courses"), "{stdout}");
+    assert!(stdout.contains("time") && stdout.contains("axis") && stdout.contains("tool"), "{stdout}");
+
+    // A tampered program fails verification with exit code 3.
+    let text = std::fs::read_to_string(&out).unwrap();
+    let line = text.lines().position(|l| l.starts_with("M60")).unwrap();
+    let tampered: Vec<&str> = text.lines().enumerate().filter(|(i, _)| *i != line).map(|(_, l)| l).collect();
+    let bad = d.join("bad.nc");
+    std::fs::write(&bad, tampered.join("\n")).unwrap();
+    let (code, _, err) = run(towpath()
+        .arg("verify")
+        .arg(d.join("planar-45.nc"))
+        .arg(&bad)
+        .arg("--machine")
+        .arg(d.join("gantry-afp.toml"))
+        .arg("--dialect")
+        .arg(d.join("dialect.toml")));
+    assert!(code == 3 || code == 2, "{code} {err}");
+    assert!(err.contains("bad.nc"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn bad_input_names_file_and_line() {
+    let d = temp_dir("bad");
+    demo(&d);
+    let text = std::fs::read_to_string(d.join("planar-0.nc")).unwrap();
+    let bad = d.join("bad.nc");
+    // Line 9 of the program gets an axis the machine does not have.
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let n = lines.iter().position(|l| l.starts_with("G1 ") && l.contains('X')).unwrap();
+    lines[n].push_str(" W3");
+    std::fs::write(&bad, lines.join("\n")).unwrap();
+    let (code, _, err) = run(towpath()
+        .arg("optimize")
+        .arg(&bad)
+        .arg("--machine")
+        .arg(d.join("gantry-afp.toml"))
+        .args(["--tow-width", "6.35", "-o"])
+        .arg(d.join("out.nc")));
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("bad.nc") && err.contains(&format!("line {}", n + 1)) && err.contains("unknown axis W"),
+        "{err}"
+    );
+    // Several plies and no width: refused, saying what to give.
+    let (code, _, err) = run(towpath()
+        .arg("optimize")
+        .arg(d.join("planar-0.nc"))
+        .arg("--machine")
+        .arg(d.join("gantry-afp.toml"))
+        .arg("-o")
+        .arg(d.join("out.nc")));
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--tow-width"), "{err}");
+    // A broken machine file names its line.
+    let m = d.join("m.toml");
+    std::fs::write(&m, "name = \"m\"\n[[axis]]\nlabel = \"X\"\nkind = \"lineer\"\n").unwrap();
+    let (code, _, err) = run(towpath()
+        .arg("optimize")
+        .arg(d.join("planar-0.nc"))
+        .arg("--machine")
+        .arg(&m)
+        .arg("-o")
+        .arg(d.join("o.nc")));
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("m.toml") && err.contains("line 4"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
