@@ -543,6 +543,8 @@ def main() -> None:
     ap.add_argument("--towpath", type=Path, default=None, help="towpath binary (default: cargo build --release)")
     ap.add_argument("--results", type=Path, default=OUT / "seq-results.jsonl")
     ap.add_argument("--resume", action="store_true", help="keep earlier results in --results, run the rest")
+    ap.add_argument("--redo", default="", help="with --resume: drop these solvers' earlier results first "
+                    "(comma-separated), e.g. `--resume --redo towpath` re-measures towpath and keeps the peers")
     ap.add_argument("--output", type=Path, default=ROOT / "BENCHMARKS.md")
     ap.add_argument("--scale-tasks", type=int, default=100_000)
     ap.add_argument("--scale-time-limit", type=float, default=60.0)
@@ -561,6 +563,10 @@ def main() -> None:
     towpath = args.towpath or (ROOT / "target" / "release" / "towpath" if args.table_only else build_towpath())
     if not args.resume and not args.table_only and not args.scale_only and args.results.exists():
         args.results.rename(args.results.with_suffix(f".{int(time.time())}.bak"))
+    redo = {x for x in args.redo.split(",") if x}
+    if redo and args.resume and args.results.exists():
+        kept = [r for r in load_results(args.results) if r["solver"] not in redo]
+        args.results.write_text("".join(json.dumps(r) + "\n" for r in kept))
     done = {(r["instance"], r["solver"], r["run"]) for r in load_results(args.results)
             if r.get("time_limit") == args.time_limit}
     instances = seqlib.read_instance_list(args.instances)
