@@ -567,7 +567,8 @@ def main() -> None:
     if redo and args.resume and args.results.exists():
         kept = [r for r in load_results(args.results) if r["solver"] not in redo]
         args.results.write_text("".join(json.dumps(r) + "\n" for r in kept))
-    done = {(r["instance"], r["solver"], r["run"]) for r in load_results(args.results)
+    # Keyed by path: names repeat across kinds (ESC47 is a SOP and a PCGTSP instance).
+    done = {(r["path"], r["solver"], r["run"]) for r in load_results(args.results)
             if r.get("time_limit") == args.time_limit}
     instances = seqlib.read_instance_list(args.instances)
     loads = []
@@ -588,11 +589,11 @@ def main() -> None:
                 convert(towpath, src, nat_json, matrix=False)
                 solvers = [] if args.only == "peers" else ["towpath"]
                 solvers += [p for p in peers if args.only != "towpath"]
-                if all((name, s, run) in done for s in solvers):
+                if all((rel, s, run) in done for s in solvers):
                     continue
                 model = Model.from_json(json.loads(mat_json.read_text()))
                 for solver in solvers:
-                    if (name, solver, run) in done:
+                    if (rel, solver, run) in done:
                         continue
                     rec = {"instance": name, "path": rel, "kind": kind, "solver": solver, "run": run, "seed": seed,
                            "time_limit": args.time_limit, "threads": args.threads, "load1": os.getloadavg()[0],
