@@ -12,7 +12,8 @@
 //!   and EXPLICIT matrices in all nine layouts), SOP, GTSP/AGTSP (GLNS format) and PCGLNS.
 //! - [`parse_json`] / [`JsonProblem`]: towpath's own JSON format (tasks with modes, precedence,
 //!   consecutive groups, route ends; states as points with a metric or as a matrix), described
-//!   in `docs/json-format.md`; [`write_json`] writes it.
+//!   in `docs/json-format.md`; [`write_json`] writes it, and [`Instance::to_json`] turns any
+//!   loaded instance into it (points or an explicit matrix, see [`CostsAs`]).
 //! - [`read_tour`] / [`parse_tour`]: TSPLIB tours, to price known optimal tours.
 //! - Every refusal is a [`FormatError`]: file, line (and column for JSON) and an [`ErrorKind`].
 //!   No input makes a reader panic.
@@ -21,6 +22,7 @@
 
 mod coords;
 mod error;
+mod export;
 mod instance;
 mod json;
 mod json_locate;
@@ -33,6 +35,7 @@ mod tsplib;
 use std::path::Path;
 
 pub use error::{ErrorKind, FormatError};
+pub use export::CostsAs;
 pub use instance::{Answer, Instance, Kind, LoadedProblem, TaskStep, UnknownNode};
 pub use json::{
     parse_json, parse_json_problem, write_json, JsonEnd, JsonMetric, JsonMode, JsonProblem, JsonStates, JsonTask,

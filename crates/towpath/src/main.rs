@@ -21,6 +21,8 @@ enum Command {
     Demo(cmd::demo::Args),
     /// Solve a TSPLIB (TSP, ATSP, SOP), GTSP-LIB, PCGLNS or towpath JSON problem file.
     Solve(cmd::solve::Args),
+    /// Write a problem file (TSPLIB, GTSP-LIB, PCGLNS, JSON) as towpath JSON, optionally with an explicit matrix.
+    Convert(cmd::convert::Args),
     /// Generate the fiber courses of a ply on a mold surface (mesh or analytic), trimmed per tow,
     /// with quality figures; write JSON, CSV and G-code.
     Layup(Box<cmd::layup::Args>),
@@ -39,6 +41,7 @@ fn main() {
     let result = match cli.command {
         Command::Demo(args) => cmd::demo::run(args),
         Command::Solve(args) => cmd::solve::run(args),
+        Command::Convert(args) => cmd::convert::run(args),
         Command::Layup(args) => cmd::layup::run(*args),
         Command::Optimize(args) => cmd::optimize::run(args),
         Command::Verify(args) => cmd::verify::run(args),

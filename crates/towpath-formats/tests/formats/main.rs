@@ -2,6 +2,7 @@
 
 mod common;
 mod errors;
+mod export;
 mod json;
 mod known;
 mod props;

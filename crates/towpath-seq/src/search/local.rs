@@ -711,7 +711,10 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                     if t3 == t1 || (depth > 1 && self.lk_touched.contains(&t3)) {
                         continue;
                     }
-                    let g1 = g - if forward { tour.arc(net, t2, t3) } else { tour.arc(net, t3, t2) };
+                    // the new arc joins t3 to t2 turned round (t2 ends the reversed stretch)
+                    let (m2, m3) = (tour.mode[t2 as usize], tour.mode[t3 as usize]);
+                    let r2 = net.rev_mode(t2, m2);
+                    let g1 = g - if forward { net.arc(t2, r2, t3, m3) } else { net.arc(t3, m3, t2, r2) };
                     if g1 <= self.eps {
                         if net.multi_mode {
                             continue;

@@ -3,6 +3,7 @@
 mod afp_common;
 pub mod bench;
 pub mod bench_baselines;
+pub mod convert;
 pub mod demo;
 pub mod layup;
 pub mod optimize;
