@@ -1,6 +1,7 @@
 //! The AFP benchmark: seed 000's test parts and a 100-ply, 10,000-course panel, optimized and
-//! verified, beside seed 000's own solver (`doherty`); prints a Markdown table and, with `--write FILE`, puts it into that file under the
-//! heading "## AFP programs (seed 000)". Run through `bench/afp.sh`.
+//! verified, beside seed 000's own solver (`doherty`); prints a Markdown table and, with
+//! `--write FILE`, puts it into that file under the heading "## AFP programs (seed 000)". Run
+//! through `bench/afp.sh`.
 //!
 //! Usage: `afp_bench [--runs N] [--time-limit S] [--big-time-limit S] [--plies P] [--courses C]
 //! [--write BENCHMARKS.md]`

@@ -9,8 +9,9 @@
 //! 3. seed 003's transformation (castelino) against towpath's direct search on GTSP-LIB and
 //!    PCGLNS files from the benchmark data (`--data`).
 //!
-//! Every solver runs on one thread, except on the GTSP files (`--gtsp-threads`, both alike). Times are wall times of the solve (shortest paths and
-//! model building excluded, they are shared), medians over instances and runs; they are noisy on
+//! Every solver runs on one thread, except on the GTSP files (`--gtsp-threads`, both alike).
+//! Times are wall times of the solve (shortest paths and model building excluded, they are
+//! shared), medians over instances and runs; they are noisy on
 //! a shared machine.
 
 mod afp_like;
