@@ -157,7 +157,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         // limit, to about a twentieth of it (an arc evaluation taken as ~5 ns).
         let mut pool_size = ((2e7 / work.max(1.0)) as usize).clamp(1, 64);
         if let Some(tl) = opts.time_limit {
-            let affordable = tl.as_secs_f64() * 0.05 / (work.max(1.0) * 5e-9);
+            let affordable = tl.as_secs_f64() * 0.25 / (work.max(1.0) * 5e-9);
             pool_size = pool_size.min(affordable as usize).max(1);
         }
         let pool = if net.depot != u32::MAX && problem.start().is_some() {
@@ -286,7 +286,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
 
 /// True when the time limit is too short to spend on descending from several starts.
 fn pool_is_short(opts: &SolveOptions, work: f64) -> bool {
-    opts.time_limit.is_some_and(|tl| tl.as_secs_f64() * 0.05 < 3.0 * work * 5e-9 * 4.0)
+    opts.time_limit.is_some_and(|tl| tl.as_secs_f64() * 0.25 < 3.0 * work * 5e-9 * 4.0)
 }
 
 fn optimize_final<C: CostModel>(net: &Net<C>, tour: &mut Tour, eps: Cost) {
