@@ -189,12 +189,42 @@ fn outputs_carry_the_courses_and_tow_events() {
         .all(|l| ["X", "Y", "Z", "A", "B", "C"].iter().all(|w| l.contains(w))));
 }
 
+/// The head frame of angles A, B, C (degrees): R = Rx(A)·Ry(B)·Rz(C).
+fn frame_of(abc: [f64; 3]) -> glam::DMat3 {
+    let [a, b, c] = abc.map(f64::to_radians);
+    glam::DMat3::from_rotation_x(a) * glam::DMat3::from_rotation_y(b) * glam::DMat3::from_rotation_z(c)
+}
+
+fn check_abc(n: DVec3, d: DVec3) {
+    let r = frame_of(output::abc(n, d));
+    assert!((r.x_axis - d).length() < 1e-9, "x {} vs d {d} (n {n})", r.x_axis);
+    assert!((r.z_axis - n).length() < 1e-9, "z {} vs n {n}", r.z_axis);
+    // C is the heading: C + 180° lays the same point the other way round, A and B unchanged.
+    let [a, b, c] = output::abc(n, d);
+    let rev = frame_of([a, b, c + 180.0]);
+    assert!((rev.x_axis + d).length() < 1e-9 && (rev.z_axis - n).length() < 1e-9);
+    let [ra, rb, _] = output::abc(n, -d);
+    assert!((ra - a).abs() < 1e-9 && (rb - b).abs() < 1e-9, "A/B change on reversal: {a} {b} vs {ra} {rb}");
+}
+
 #[test]
-fn abc_angles_rebuild_the_frame() {
+fn abc_angles_rebuild_the_frame_and_c_is_the_heading() {
     let n = DVec3::new(0.3, -0.2, 0.9).normalize();
-    let d = n.any_orthonormal_vector();
-    let [a, b, c] = output::abc(n, d).map(f64::to_radians);
-    let r = glam::DMat3::from_rotation_z(c) * glam::DMat3::from_rotation_y(b) * glam::DMat3::from_rotation_x(a);
-    assert!((r.x_axis - d).length() < 1e-12);
-    assert!((r.z_axis - n).length() < 1e-12);
+    check_abc(n, n.any_orthonormal_vector());
+    // Gimbal lock (normal along ±X) and the plain cases.
+    check_abc(DVec3::X, DVec3::new(0.0, 0.6, 0.8));
+    check_abc(-DVec3::X, DVec3::new(0.0, -0.8, 0.6));
+    check_abc(DVec3::Z, DVec3::X);
+    check_abc(-DVec3::Z, DVec3::Y);
+}
+
+proptest::proptest! {
+    #[test]
+    fn abc_angles_rebuild_any_frame(
+        nx in -1.0f64..1.0, ny in -1.0f64..1.0, nz in -1.0f64..1.0, phi in 0.0f64..std::f64::consts::TAU
+    ) {
+        let Some(n) = DVec3::new(nx, ny, nz).try_normalize() else { return Ok(()) };
+        let (u, v) = n.any_orthonormal_pair();
+        check_abc(n, u * phi.cos() + v * phi.sin());
+    }
 }
