@@ -70,6 +70,42 @@ fn tow_points(c: &towpath_layup::course::Course, band: Band, k: usize, s: f64) -
     [p + b * band.edge(k), p + b * band.centre(k), p + b * band.edge(k + 1)]
 }
 
+/// Checks every tow end of a ply against an independent inside test of the boundary under the
+/// coverage rule: just before a laid end the rule holds, just beyond it does not. Returns the
+/// number of ends checked.
+fn check_tow_ends(ply: &Ply, band: Band, rule: Coverage, inside: &dyn Fn(DVec3) -> bool, what: &str) -> usize {
+    let eps = 0.05;
+    let mut ends = 0;
+    for c in &ply.courses {
+        for (k, ivs) in c.tows.iter().enumerate() {
+            for iv in ivs {
+                for (s, outward) in [(iv[0], -1.0), (iv[1], 1.0)] {
+                    let at = tow_points(c, band, k, s);
+                    let just_out = tow_points(c, band, k, s + outward * eps);
+                    let just_in = tow_points(c, band, k, s - outward * eps);
+                    let where_ = format!("{what} {rule:?} course {} tow {k} s {s} of {} {iv:?} at {at:?}", c.id, c.length());
+                    match rule {
+                        // All of the tow inside while laid; some part outside just beyond.
+                        Coverage::Zero => {
+                            assert!(just_in.iter().all(|&q| inside(q)), "{where_}: in {just_in:?}");
+                            assert!(!just_out.iter().all(|&q| inside(q)), "{where_}: out {just_out:?}");
+                        }
+                        Coverage::Half => {
+                            assert!(inside(just_in[1]) && !inside(just_out[1]), "{where_}");
+                        }
+                        Coverage::Full => {
+                            assert!(just_in.iter().any(|&q| inside(q)), "{where_}: in {just_in:?}");
+                            assert!(!just_out.iter().any(|&q| inside(q)), "{where_}: out {just_out:?}");
+                        }
+                    }
+                    ends += 1;
+                }
+            }
+        }
+    }
+    ends
+}
+
 #[test]
 fn tows_are_cut_and_restarted_at_the_ply_boundary_under_each_rule() {
     // A 45° ply inside a square boundary 100..700 on a larger plate: every tow end must sit where
@@ -84,56 +120,55 @@ fn tows_are_cut_and_restarted_at_the_ply_boundary_under_each_rule() {
     let region = Region::curve(&mesh, &square, 3.0, Some(DVec3::new(400.0, 400.0, 0.0))).unwrap();
     let inside = |q: DVec3| q.x >= 100.0 - 1e-6 && q.x <= 700.0 + 1e-6 && q.y >= 100.0 - 1e-6 && q.y <= 700.0 + 1e-6;
     let band = Band { tow_width: 6.35, tows: 8 };
-    let mut coverage_by_rule = Vec::new();
-    for rule in [Coverage::Zero, Coverage::Half, Coverage::Full] {
-        let ply = run(&mesh, &region, 45.0, 8, rule, DVec3::new(400.0, 400.0, 0.0), Method::Field);
-        assert!(ply.courses.len() >= 10);
-        let eps = 0.05;
-        let mut ends = 0;
-        for c in &ply.courses {
-            for (k, ivs) in c.tows.iter().enumerate() {
-                for iv in ivs {
-                    for (s, outward) in [(iv[0], -1.0), (iv[1], 1.0)] {
-                        let at = tow_points(c, band, k, s);
-                        let just_out = tow_points(c, band, k, s + outward * eps);
-                        let just_in = tow_points(c, band, k, s - outward * eps);
-                        match rule {
-                            // All of the tow inside while laid; some part outside just beyond.
-                            Coverage::Zero => {
-                                assert!(
-                                    just_in.iter().all(|&q| inside(q)),
-                                    "{rule:?} course {} tow {k} s {s} {iv:?} at {at:?} in {just_in:?}",
-                                    c.id
-                                );
-                                assert!(
-                                    !just_out.iter().all(|&q| inside(q)),
-                                    "{rule:?} course {} tow {k} s {s} {iv:?} len {} out {just_out:?}",
-                                    c.id,
-                                    c.length()
-                                );
-                            }
-                            Coverage::Half => {
-                                assert!(inside(just_in[1]) && !inside(just_out[1]), "{rule:?}: centre {:?}", at[1]);
-                            }
-                            Coverage::Full => {
-                                assert!(just_in.iter().any(|&q| inside(q)), "{rule:?}");
-                                assert!(!just_out.iter().any(|&q| inside(q)), "{rule:?}");
-                            }
-                        }
-                        ends += 1;
-                    }
-                }
-            }
+    for method in [Method::Field, Method::Parallel, Method::Natural] {
+        let mut coverage_by_rule = Vec::new();
+        for rule in [Coverage::Zero, Coverage::Half, Coverage::Full] {
+            let ply = run(&mesh, &region, 45.0, 8, rule, DVec3::new(400.0, 400.0, 0.0), method);
+            assert!(ply.courses.len() >= 10);
+            assert!(check_tow_ends(&ply, band, rule, &inside, &format!("{method:?}")) > 100);
+            coverage_by_rule.push(ply.quality.coverage_percent);
         }
-        assert!(ends > 100);
-        coverage_by_rule.push(ply.quality.coverage_percent);
+        // Less material inside the boundary the earlier tows are cut.
+        assert!(
+            coverage_by_rule[0] < coverage_by_rule[1] && coverage_by_rule[1] < coverage_by_rule[2],
+            "{method:?} {coverage_by_rule:?}"
+        );
+        assert!(coverage_by_rule[2] > 99.9, "{method:?} {coverage_by_rule:?}");
     }
-    // Less material inside the boundary the earlier tows are cut.
-    assert!(
-        coverage_by_rule[0] < coverage_by_rule[1] && coverage_by_rule[1] < coverage_by_rule[2],
-        "{coverage_by_rule:?}"
-    );
-    assert!(coverage_by_rule[2] > 99.9, "{coverage_by_rule:?}");
+}
+
+#[test]
+fn parallel_courses_are_extended_to_a_widening_boundary() {
+    // A trapezoid 200 mm wide at y = 100 and 600 mm wide at y = 700: every 0° course is longer
+    // than the one before it, so each geodesic offset stops short of the boundary and must be
+    // extended along the surface until it leaves the ply (seed 002 §4).
+    let mesh = plate(800.0, 800.0);
+    let trapezoid = [
+        DVec3::new(300.0, 100.0, 0.0),
+        DVec3::new(500.0, 100.0, 0.0),
+        DVec3::new(700.0, 700.0, 0.0),
+        DVec3::new(100.0, 700.0, 0.0),
+    ];
+    let start = DVec3::new(400.0, 130.0, 0.0);
+    let region = Region::curve(&mesh, &trapezoid, 3.0, Some(start)).unwrap();
+    // Half-width of the trapezoid at height y about x = 400.
+    let inside = |q: DVec3| {
+        let half = 100.0 + (q.y - 100.0) / 3.0;
+        (100.0 - 1e-6..=700.0 + 1e-6).contains(&q.y) && (q.x - 400.0).abs() <= half + 1e-6
+    };
+    let band = Band { tow_width: 6.35, tows: 8 };
+    for rule in [Coverage::Zero, Coverage::Half, Coverage::Full] {
+        let ply = run(&mesh, &region, 0.0, 8, rule, start, Method::Parallel);
+        // 600 mm of height in courses of 50.8 mm.
+        assert!(ply.courses.len() >= 12, "{}", ply.courses.len());
+        assert!(check_tow_ends(&ply, band, rule, &inside, "parallel") > 100);
+        // The last course on the wide side is as long as the trapezoid there.
+        let top = ply.courses.iter().max_by(|a, b| a.points[0].p.y.total_cmp(&b.points[0].p.y)).unwrap();
+        let y = top.points[0].p.y;
+        let expect = 2.0 * (100.0 + (y - 100.0) / 3.0);
+        let laid = top.laid_range().unwrap();
+        assert!((laid[1] - laid[0]) > expect - band.width(), "{rule:?}: top course at y {y}: {laid:?} vs {expect}");
+    }
 }
 
 #[test]
