@@ -582,8 +582,18 @@ fn crop(c: &mut Course) {
         let i = c.points.partition_point(|q| q.s < s).min(c.points.len().saturating_sub(1));
         c.points.get(i).map_or(NO_FACE, |q| q.face)
     };
+    // A new end point is on the surface only if the segment it lies in is (both its ends are): an
+    // end cut inside a run-out is off the mesh even when the next point is on it.
+    let flag_at = |s: f64| {
+        let i = c.points.partition_point(|q| q.s < s);
+        match (c.points.get(i), c.on_surface.get(i)) {
+            (Some(q), Some(&o)) if (q.s - s).abs() <= 1e-9 => o,
+            _ => c.on_surface_at(s),
+        }
+    };
+    let (on_a, on_b) = (flag_at(a), flag_at(b));
     let mut pts = vec![PathPoint { p: pa, n: na, d: da, s: a, face: NO_FACE }];
-    let mut on = vec![c.on_surface.get(c.points.partition_point(|q| q.s < a)).copied().unwrap_or(true)];
+    let mut on = vec![on_a];
     for (q, &o) in c.points.iter().zip(&c.on_surface) {
         if q.s > a + 1e-9 && q.s < b - 1e-9 {
             pts.push(*q);
@@ -591,12 +601,7 @@ fn crop(c: &mut Course) {
         }
     }
     pts.push(PathPoint { p: pb, n: nb, d: db, s: b, face: face_at(b) });
-    on.push(
-        c.on_surface
-            .get(c.points.partition_point(|q| q.s < b).min(c.points.len().saturating_sub(1)))
-            .copied()
-            .unwrap_or(true),
-    );
+    on.push(on_b);
     // Re-base arc length to start at zero.
     for q in &mut pts {
         q.s -= a;
