@@ -104,12 +104,15 @@ pub struct Sectioner<'a> {
     pub region: &'a Region,
     /// The band.
     pub band: Band,
+    /// Surface already covered (by other courses): lines there count as outside the ply, so a
+    /// closing course is trimmed against the courses laid before it under the same rule.
+    pub occupied: Option<&'a (dyn Fn(DVec3) -> bool + Sync)>,
 }
 
 impl Sectioner<'_> {
     /// Inside test of a point known to be on the mesh.
     fn inside_curve(&self, q: DVec3) -> bool {
-        !self.region.has_curve() || self.region.curve_distance(q) >= 0.0
+        (!self.region.has_curve() || self.region.curve_distance(q) >= 0.0) && !self.occupied.is_some_and(|f| f(q))
     }
 
     /// Whether a point near the mesh edge (possibly off the surface) lies over the mesh rather than
@@ -155,7 +158,7 @@ impl Sectioner<'_> {
             let nf = self.mesh.face_normal(l.sp.face);
             (v - nf * v.dot(nf)).length() <= 1e-3 * self.band.tow_width
         });
-        if centre_on_mesh && sd > margin && self.region.mesh_edges.distance(p) > margin {
+        if centre_on_mesh && sd > margin && self.region.mesh_edges.distance(p) > margin && self.occupied.is_none() {
             return vec![true; offsets.len()];
         }
         let b = n.cross(d).normalize_or_zero();
