@@ -454,7 +454,14 @@ impl Planner<'_> {
     /// The next course one width across from `prev` towards `sign` for the ply's method;
     /// `on_existing` allows it to land on courses already laid (the closing course).
     /// `prev_index` is the lateral index of `prev`.
-    fn next_course(&self, prev: &[PathPoint], prev_index: i32, sign: f64, steer: Steering<'_>, on_existing: bool) -> Next {
+    fn next_course(
+        &self,
+        prev: &[PathPoint],
+        prev_index: i32,
+        sign: f64,
+        steer: Steering<'_>,
+        on_existing: bool,
+    ) -> Next {
         match self.spec.method {
             Method::Parallel => self.parallel(prev, prev_index, sign, on_existing),
             Method::Field | Method::Natural => self.seeded(prev, prev_index, sign, steer, on_existing),

@@ -260,7 +260,11 @@ fn helical_ply_on_a_tube_is_closed_by_a_course_trimmed_against_the_laid_ones() {
             let laid: Vec<usize> = (0..tows).filter(|&k| !closing.tows[k].is_empty()).collect();
             assert_eq!(laid.len(), if rule == Coverage::Zero { 1 } else { 2 }, "{method:?} {rule:?}: {laid:?}");
             for &k in &laid {
-                assert!(closing.tows[k].iter().all(|iv| iv[1] - iv[0] > 500.0), "{method:?} {rule:?}: {:?}", closing.tows[k]);
+                assert!(
+                    closing.tows[k].iter().all(|iv| iv[1] - iv[0] > 500.0),
+                    "{method:?} {rule:?}: {:?}",
+                    closing.tows[k]
+                );
             }
             if rule != Coverage::Zero {
                 assert!(ply.quality.coverage_percent > 99.5, "{method:?} {rule:?}: {}", ply.quality.coverage_percent);

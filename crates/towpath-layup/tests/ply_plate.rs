@@ -83,7 +83,8 @@ fn check_tow_ends(ply: &Ply, band: Band, rule: Coverage, inside: &dyn Fn(DVec3) 
                     let at = tow_points(c, band, k, s);
                     let just_out = tow_points(c, band, k, s + outward * eps);
                     let just_in = tow_points(c, band, k, s - outward * eps);
-                    let where_ = format!("{what} {rule:?} course {} tow {k} s {s} of {} {iv:?} at {at:?}", c.id, c.length());
+                    let where_ =
+                        format!("{what} {rule:?} course {} tow {k} s {s} of {} {iv:?} at {at:?}", c.id, c.length());
                     match rule {
                         // All of the tow inside while laid; some part outside just beyond.
                         Coverage::Zero => {
