@@ -38,6 +38,10 @@ fn zero_degree_ply_fills_a_plate_of_whole_courses_exactly() {
         let ply = run(&mesh, &region, 0.0, 8, Coverage::Half, DVec3::new(500.0, 279.4, 0.0), method);
         assert_eq!(ply.courses.len(), 12, "{method:?}");
         assert_eq!(ply.n1 + ply.n2 + 1, 12);
+        // The reference at y = 279.4 has 330.2 mm of plate to its left and 279.4 mm to its right:
+        // seed 002 eq. 9 (beyond the reference's own half width) gives 6 and 5 courses.
+        assert_eq!((ply.n1, ply.n2), (6, 5), "{method:?}");
+        assert_eq!(ply.n_estimate, [6, 5], "{method:?}");
         // Courses 50.8 mm apart, from y = 25.4 to 584.2, each along the full length.
         for (i, c) in ply.courses.iter().enumerate() {
             let y = 25.4 + 50.8 * i as f64;
