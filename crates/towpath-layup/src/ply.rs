@@ -173,7 +173,7 @@ pub fn plan(
     let start_pt = spec.start.unwrap_or_else(|| default_start(mesh, region));
     let sp = mesh.closest_point(start_pt).ok_or(PlyError::Empty)?;
     let start = Located::new(mesh, sp);
-    if region.has_curve() && region.curve_distance(start.p) < 0.0 {
+    if region.has_curve() && region.curve_distance(start.p, start.n) < 0.0 {
         return Err(PlyError::StartOutside(start.p.to_array()));
     }
     let d0 = field.direction(start.p, start.n).ok_or(PlyError::NoDirection(start.p.to_array()))?;
@@ -359,13 +359,13 @@ impl Planner<'_> {
     }
 
     /// Whether a course centre at p would still put material in the ply.
-    fn useful(&self, p: DVec3) -> bool {
-        !self.region.has_curve() || self.region.curve_distance(p) > -0.5 * self.width()
+    fn useful(&self, p: DVec3, n: DVec3) -> bool {
+        !self.region.has_curve() || self.region.curve_distance(p, n) > -0.5 * self.width()
     }
 
     /// The stop test of centreline traces: far outside the ply boundary.
-    fn outside_far(&self, p: DVec3) -> bool {
-        self.region.has_curve() && self.region.curve_distance(p) < -1.5 * self.width()
+    fn outside_far(&self, p: DVec3, n: DVec3) -> bool {
+        self.region.has_curve() && self.region.curve_distance(p, n) < -1.5 * self.width()
     }
 
     /// Traces a centreline in both directions from `start`. A closed loop (a hoop on a tube) is
@@ -381,7 +381,7 @@ impl Planner<'_> {
         let mut closed = false;
         let mut last = start.p;
         let (mut fwd, _) = walk(self.mesh, start, d_start, steer, &opts, |q| {
-            if self.outside_far(q.p) {
+            if self.outside_far(q.p, q.n) {
                 return true;
             }
             // Back at the start (a hoop): the step from the previous point passes the start.
@@ -408,7 +408,7 @@ impl Planner<'_> {
         let bwd = if closed {
             Vec::new()
         } else {
-            walk(self.mesh, start, -d_start, steer, &opts, |q| self.outside_far(q.p)).0
+            walk(self.mesh, start, -d_start, steer, &opts, |q| self.outside_far(q.p, q.n)).0
         };
         let total_b = bwd.last().map_or(0.0, |q| q.s);
         let mut pts = Vec::with_capacity(fwd.len() + bwd.len() + 1);
@@ -488,12 +488,12 @@ impl Planner<'_> {
         cands.sort_by(|a, b| (a - mid).abs().total_cmp(&(b - mid).abs()));
         for s in cands {
             let (p, n, d) = crate::course::frame_at(prev, s);
-            if !self.useful(p) {
+            if !self.useful(p, n) {
                 continue;
             }
             let at = PathPoint { p, n, d, s, face: crate::course::face_hint(prev, s) };
             let Some((loc, dt)) = self.across(&at, sign, w, true) else { continue };
-            if !self.useful(loc.p) {
+            if !self.useful(loc.p, loc.n) {
                 continue;
             }
             let (dist, owner) = self.near_existing(loc.p);
@@ -562,7 +562,7 @@ impl Planner<'_> {
             }
             pts.push(PathPoint { p: loc.p, n: loc.n, d: dt, s: 0.0, face: NO_FACE });
         }
-        let useful = pts.iter().filter(|q| self.useful(q.p)).count();
+        let useful = pts.iter().filter(|q| self.useful(q.p, q.n)).count();
         if useful == 0 {
             return Next::End;
         }
@@ -593,7 +593,7 @@ impl Planner<'_> {
         let opts = WalkOptions::up_to(self.max_len);
         let ext = |q: &PathPoint, dir: DVec3| -> Vec<PathPoint> {
             let Some(loc) = crate::course::locate(self.mesh, q.p, q.face) else { return Vec::new() };
-            walk(self.mesh, loc, dir, Steering::Geodesic, &opts, |x| self.outside_far(x.p)).0
+            walk(self.mesh, loc, dir, Steering::Geodesic, &opts, |x| self.outside_far(x.p, x.n)).0
         };
         let (Some(&first), Some(&last)) = (pts.first(), pts.last()) else { return Next::End };
         let head = ext(&first, -first.d);
@@ -669,7 +669,7 @@ impl Planner<'_> {
         for i in 0..=count {
             let s = len * i as f64 / count as f64;
             let (p, n, d) = crate::course::frame_at(reference, s);
-            if self.region.has_curve() && self.region.curve_distance(p) < 0.0 {
+            if self.region.has_curve() && self.region.curve_distance(p, n) < 0.0 {
                 continue;
             }
             let Some(start) = crate::course::locate(self.mesh, p, crate::course::face_hint(reference, s)) else {
@@ -679,7 +679,7 @@ impl Planner<'_> {
                 let b = n.cross(d) * sign;
                 let opts = WalkOptions::up_to(self.max_len);
                 let (wk, _) = walk(self.mesh, start, b, Steering::Geodesic, &opts, |q| {
-                    (self.region.has_curve() && self.region.curve_distance(q.p) < 0.0)
+                    (self.region.has_curve() && self.region.curve_distance(q.p, q.n) < 0.0)
                         || (q.s > w && q.p.distance(start.p) < 0.02 * w)
                 });
                 let l = wk.last().map_or(0.0, |q| q.s);

@@ -296,6 +296,7 @@ pub fn assess(
         .par_iter()
         .map(|&f| {
             let c = mesh.corners(f);
+            let nf = mesh.face_normal(f);
             let m = (edge_max(f) / h).ceil().clamp(1.0, 16.0) as usize;
             let a = mesh.face_area(f) / (m * m) as f64;
             let (mut area, mut covered) = (0.0, 0.0);
@@ -309,7 +310,7 @@ pub fn assess(
                     for (u, v) in pts {
                         let (u, v) = (u / m as f64, v / m as f64);
                         let x = c[0] * (1.0 - u - v) + c[1] * u + c[2] * v;
-                        if region.has_curve() && region.curve_distance(x) < 0.0 {
+                        if region.has_curve() && region.curve_distance(x, nf) < 0.0 {
                             continue;
                         }
                         area += a;

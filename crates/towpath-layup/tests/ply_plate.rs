@@ -268,3 +268,67 @@ proptest::proptest! {
         check_abc(n, u * phi.cos() + v * phi.sin());
     }
 }
+
+/// A closed thin box [0, a] × [0, b] × [0, t] as a triangle soup, faces split every ~`h` mm,
+/// outward orientation.
+fn thin_box(a: f64, b: f64, t: f64, h: f64) -> Mesh {
+    let mut tris: Vec<[DVec3; 3]> = Vec::new();
+    // A rectangle from corner o along u and v (outward normal u × v), split into a grid.
+    let mut rect = |o: DVec3, u: DVec3, v: DVec3| {
+        let (nu, nv) = ((u.length() / h).ceil().max(1.0) as usize, (v.length() / h).ceil().max(1.0) as usize);
+        for i in 0..nu {
+            for j in 0..nv {
+                let p = |ii: usize, jj: usize| o + u * (ii as f64 / nu as f64) + v * (jj as f64 / nv as f64);
+                tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+                tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+            }
+        }
+    };
+    let (x, y, z) = (DVec3::X * a, DVec3::Y * b, DVec3::Z * t);
+    rect(DVec3::ZERO + z, x, y); // top, +z
+    rect(DVec3::ZERO, y, x); // bottom, −z
+    rect(DVec3::ZERO, x, z); // y = 0 side, −y
+    rect(y, z, x); // y = b side, +y
+    rect(DVec3::ZERO, z, y); // x = 0 side, −x
+    rect(x, y, z); // x = a side, +x
+    let soup = towpath_geom::Soup::from_triangles(tris);
+    Mesh::build(&soup, &BuildOptions::default()).unwrap().0
+}
+
+#[test]
+fn a_boundary_on_one_skin_of_a_thin_part_does_not_take_in_the_other_skin() {
+    // A 4 mm thin closed box; the ply boundary is a square on the top skin. The bottom skin lies
+    // 4 mm from the boundary in space but on the other side of the part: no tow may be laid there,
+    // and the ply area is the square's.
+    let mesh = thin_box(600.0, 400.0, 4.0, 20.0);
+    assert!(mesh.boundary_loops().is_empty());
+    let square = [
+        DVec3::new(100.0, 100.0, 4.0),
+        DVec3::new(500.0, 100.0, 4.0),
+        DVec3::new(500.0, 300.0, 4.0),
+        DVec3::new(100.0, 300.0, 4.0),
+    ];
+    let start = DVec3::new(300.0, 200.0, 4.0);
+    let region = Region::curve(&mesh, &square, 3.0, Some(start)).unwrap();
+    let inside = |q: DVec3| {
+        q.z > 4.0 - 1e-6 && (100.0 - 1e-6..=500.0 + 1e-6).contains(&q.x) && (100.0 - 1e-6..=300.0 + 1e-6).contains(&q.y)
+    };
+    let band = Band { tow_width: 6.35, tows: 8 };
+    for rule in [Coverage::Zero, Coverage::Half, Coverage::Full] {
+        let ply = run(&mesh, &region, 30.0, 8, rule, start, Method::Field);
+        for c in &ply.courses {
+            for (k, ivs) in c.tows.iter().enumerate() {
+                for iv in ivs {
+                    for i in 0..=20 {
+                        let s = iv[0] + (iv[1] - iv[0]) * i as f64 / 20.0;
+                        let centre = tow_points(c, band, k, s)[1];
+                        assert!(centre.z > 3.0, "{rule:?} course {} tow {k} laid at {centre} (bottom skin)", c.id);
+                    }
+                }
+            }
+        }
+        assert!(check_tow_ends(&ply, band, rule, &inside, "thin box") > 50);
+        let area = 400.0 * 200.0;
+        assert!((ply.quality.ply_area - area).abs() < 0.02 * area, "{rule:?}: ply area {}", ply.quality.ply_area);
+    }
+}
