@@ -53,7 +53,11 @@ impl Chain {
 #[derive(Clone, Copy)]
 pub(crate) struct Budget {
     pub kicks: u64,
+    /// No new kick after this (the end of an epoch or of the search).
     pub deadline: Option<Instant>,
+    /// The end of the search: a local search still running then is cut short and its kick
+    /// undone, so that the best tour is always a local optimum.
+    pub hard: Option<Instant>,
 }
 
 pub(crate) struct Ils<'a, 'p, C> {
@@ -97,7 +101,7 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
     pub fn run(&self, state: &mut Chain, budget: Budget, cancel: Option<&AtomicBool>) -> u64 {
         let Chain { cur, best, rng, stagnation } = state;
         let mut ls = LocalSearch::new(self.net, self.nb, self.eps);
-        ls.deadline = budget.deadline;
+        ls.deadline = budget.hard;
         let n = cur.len();
         let mut kicks = 0u64;
         let mut changed = Vec::new();
@@ -130,6 +134,9 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
                 }
                 ls.run(cur);
                 cur.commit();
+                if ls.cut {
+                    break;
+                }
                 continue;
             }
             let before = cur.cost;
@@ -162,6 +169,11 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
                     }
                     ls.run(cur);
                 }
+            }
+            if ls.cut {
+                // out of time in the middle of the local search
+                cur.undo();
+                break;
             }
             *stagnation += 1;
             if cur.cost <= before + self.eps * 0.5 {

@@ -40,6 +40,9 @@ pub(crate) struct LocalSearch<'a, 'p, C> {
     /// Scan at most this many positions each way when precedence forces scanning.
     scan_limit: usize,
     pub deadline: Option<Instant>,
+    /// Set when a run stopped at the deadline with work left (the tour may not be a local
+    /// optimum).
+    pub cut: bool,
     /// Moves applied since creation (for statistics).
     pub moves: u64,
     /// Endpoints of the arcs changed by the current Lin–Kernighan chain.
@@ -68,6 +71,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             two_opt: net.reversal_symmetric && !net.has_prec,
             scan_limit: SCAN_RADIUS,
             deadline: None,
+            cut: false,
             moves: 0,
             lk_touched: Vec::new(),
         }
@@ -101,6 +105,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 if let Some(d) = self.deadline {
                     if Instant::now() >= d {
                         self.clear();
+                        self.cut = true;
                         break;
                     }
                 }

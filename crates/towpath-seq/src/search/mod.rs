@@ -216,23 +216,30 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
     };
     let slice =
         opts.time_limit.map(|d| (d / epochs_planned as u32).clamp(Duration::from_millis(50), Duration::from_secs(2)));
+    // The search stops a little early to leave time for a last full pass of the local search
+    // (don't-look bits leave a few improving moves behind on large instances).
+    let search_end = deadline.map(|d| {
+        let reserve =
+            opts.time_limit.map_or(Duration::ZERO, |tl| (tl / 10).min(Duration::from_secs_f64(net.n as f64 * 10e-6)));
+        d - reserve
+    });
     let mut chains: Vec<ils::Chain> = (0..threads)
         .map(|t| ils::Chain::new(&best, opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ t as u64))
         .collect();
     while iterations < total_kicks {
-        if deadline.is_some_and(|d| Instant::now() >= d) {
+        if search_end.is_some_and(|d| Instant::now() >= d) {
             break;
         }
         if opts.cancel.as_ref().is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
             break;
         }
-        let epoch_deadline = match (deadline, slice) {
+        let epoch_deadline = match (search_end, slice) {
             (Some(d), Some(s)) => Some(d.min(Instant::now() + s)),
             _ => None,
         };
         let left = total_kicks - iterations;
         let kicks_each = per_epoch.min(left.div_ceil(threads as u64));
-        let budget = Budget { kicks: kicks_each, deadline: epoch_deadline };
+        let budget = Budget { kicks: kicks_each, deadline: epoch_deadline, hard: search_end };
         let cancel = opts.cancel.as_deref();
         let done: u64 = if threads == 1 {
             ils.run(&mut chains[0], budget, cancel)
@@ -271,6 +278,9 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         if done == 0 {
             break;
         }
+    }
+    if !opts.cancel.as_ref().is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+        ils.descend(&mut best, deadline);
     }
     optimize_final(&net, &mut best, eps);
     let steps = steps_from_tour(&net, &best);
