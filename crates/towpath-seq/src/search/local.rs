@@ -642,9 +642,8 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 pc - 1
             }
         };
-        // Positive-gain criterion (Lin–Kernighan's, a heuristic): with one mode per task, a new
-        // arc at least as long as the removal gain is taken not to pay off; neighbour lists are
-        // sorted, so the scan stops there.
+        // With one mode per task and symmetric costs, a new arc at least as long as the removal
+        // gain cannot pay off (positive-gain criterion); neighbour lists are sorted, so stop.
         // With several modes (when they are a task's orientations) the lists' lower bounds
         // (cheapest over mode pairs) stand in for the arc, and a single task's cheapest mode cost
         // joins it (its mode may change).
