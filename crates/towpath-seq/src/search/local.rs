@@ -647,20 +647,11 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         // With several modes (when they are a task's orientations) the lists' lower bounds
         // (cheapest over mode pairs) stand in for the arc, and a single task's cheapest mode cost
         // joins it (its mode may change).
-        let symmetric = net.p.cost_model().is_symmetric();
-        let prune = if net.multi_mode { net.reversal_symmetric && !net.modes_self_reverse && symmetric } else { true };
+        let prune = (!net.multi_mode || (net.reversal_symmetric && !net.modes_self_reverse))
+            && net.p.cost_model().is_symmetric();
         let slack = if net.multi_mode && i == j { net.min_mode_cost(s) } else { 0.0 };
         let too_long = |a: u32, b: u32, lb: Cost| {
-            prune
-                && if net.multi_mode {
-                    lb + slack >= gain
-                } else if symmetric {
-                    tour.arc(net, a, b) >= gain
-                } else {
-                    // asymmetric costs need not obey the triangle inequality: an arc as long as
-                    // the gain can still pay off; only longer ones stop the scan
-                    tour.arc(net, a, b) > gain + self.eps
-                }
+            prune && if net.multi_mode { lb + slack >= gain } else { tour.arc(net, a, b) >= gain }
         };
         let nb = self.nb;
         for (&c, &lb) in nb.inn(s).iter().zip(nb.inn_lb(s)) {
