@@ -162,10 +162,9 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
                 changed.clear();
                 if optimize_modes_noting(self.net, cur, self.eps, &mut changed) {
                     for &v in &changed {
-                        let p = cur.pos[v as usize] as usize;
                         ls.push(v);
-                        ls.push(cur.seq[if p == 0 { n - 1 } else { p - 1 }]);
-                        ls.push(cur.next_of_pos(p));
+                        ls.push(cur.prev(v));
+                        ls.push(cur.next(v));
                     }
                     ls.run(cur);
                 }

@@ -154,10 +154,10 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
     }
     if starts.is_empty() {
         // The seed pool is sized to the work (at most ~2·10⁷ arc evaluations) and, under a time
-        // limit, to about a twentieth of it (an arc evaluation taken as ~5 ns).
+        // limit, to a quarter of it.
         let mut pool_size = ((2e7 / work.max(1.0)) as usize).clamp(1, 64);
         if let Some(tl) = opts.time_limit {
-            let affordable = tl.as_secs_f64() * 0.25 / (work.max(1.0) * 5e-9);
+            let affordable = tl.as_secs_f64() * START_SHARE / (work.max(1.0) * ARC_SECONDS);
             pool_size = pool_size.min(affordable as usize).max(1);
         }
         let pool = if net.depot != u32::MAX && problem.start().is_some() {
@@ -294,9 +294,16 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
     Ok(SolveReport { solution, initial_cost, first_local_optimum, iterations, elapsed: t0.elapsed(), exact: false })
 }
 
-/// True when the time limit is too short to spend on descending from several starts.
+/// Share of a time limit the construction and the first descents may take.
+const START_SHARE: f64 = 0.25;
+
+/// Time of one arc evaluation, as assumed when sizing work to a time limit.
+const ARC_SECONDS: f64 = 5e-9;
+
+/// True when the time limit is too short to spend on descending from several starts (three
+/// descents taken as four times a construction's work each).
 fn pool_is_short(opts: &SolveOptions, work: f64) -> bool {
-    opts.time_limit.is_some_and(|tl| tl.as_secs_f64() * 0.25 < 3.0 * work * 5e-9 * 4.0)
+    opts.time_limit.is_some_and(|tl| tl.as_secs_f64() * START_SHARE < 3.0 * 4.0 * work * ARC_SECONDS)
 }
 
 fn optimize_final<C: CostModel>(net: &Net<C>, tour: &mut Tour, eps: Cost) {

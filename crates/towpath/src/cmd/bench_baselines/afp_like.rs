@@ -16,7 +16,7 @@
 use std::time::Duration;
 
 use towpath_baselines::{solve_with, BaselineParams, DohertyParams, PrecedenceSet, SolverName};
-use towpath_seq::{check, End, Metric, Mode, PointCost, Problem, SolveOptions, StateId, Step, TaskId};
+use towpath_seq::{check, End, Metric, Mode, PointCost, Problem, SolveOptions, SolveReport, StateId, Step, TaskId};
 
 use super::{ms, Args};
 
@@ -171,18 +171,11 @@ pub fn run(args: &Args) -> anyhow::Result<String> {
             ..SolveOptions::default()
         };
         let t = solve_with(SolverName::Towpath, p, &opts, &params)?;
-        let save = |c: f64| 100.0 * (original - c) / original;
         s.push_str(&format!(
-            "| {} | {} | {:.0} | {:.0} | {:.1} % | {:.0} | {:.1} % | {} | {} | {} |\n",
+            "| {} | {} | {} {} |\n",
             part.name,
             p.num_tasks(),
-            original,
-            d.solution.cost,
-            save(d.solution.cost),
-            t.solution.cost,
-            save(t.solution.cost),
-            ms(d.elapsed.as_secs_f64()),
-            ms(t.elapsed.as_secs_f64()),
+            compared(original, &d, &t),
             part.paper_saving
         ));
         eprintln!("seed 000 part {} done", part.name);
@@ -224,19 +217,12 @@ fn demo_table(towpath_s: f64) -> anyhow::Result<String> {
             ..SolveOptions::default()
         };
         let t = sequence(SolverName::Towpath, &params, &program, &afp, &afp_opts, &opts)?;
-        let save = |c: f64| 100.0 * (original - c) / original;
         s.push_str(&format!(
-            "| {} | {} | {} | {:.0} | {:.0} | {:.1} % | {:.0} | {:.1} % | {} | {} |\n",
+            "| {} | {} | {} | {}\n",
             part.name,
             afp.problem.num_tasks(),
             afp.sets.iter().filter(|c| !c.is_empty()).count(),
-            original,
-            d.solution.cost,
-            save(d.solution.cost),
-            t.solution.cost,
-            save(t.solution.cost),
-            ms(d.elapsed.as_secs_f64()),
-            ms(t.elapsed.as_secs_f64()),
+            compared(original, &d, &t),
         ));
         eprintln!("seed 000 demo part {} done", part.name);
     }
@@ -274,4 +260,19 @@ mod tests {
             check(&b.problem, &b.original).unwrap();
         }
     }
+}
+
+/// The cells both tables share: original cost, doherty's cost and saving, towpath's cost and
+/// saving, both solve times (each cell followed by ` |`).
+fn compared(original: f64, d: &SolveReport, t: &SolveReport) -> String {
+    let save = |c: f64| 100.0 * (original - c) / original;
+    format!(
+        "{original:.0} | {:.0} | {:.1} % | {:.0} | {:.1} % | {} | {} |",
+        d.solution.cost,
+        save(d.solution.cost),
+        t.solution.cost,
+        save(t.solution.cost),
+        ms(d.elapsed.as_secs_f64()),
+        ms(t.elapsed.as_secs_f64()),
+    )
 }
