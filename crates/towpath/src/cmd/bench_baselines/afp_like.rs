@@ -230,6 +230,21 @@ fn demo_table(towpath_s: f64) -> anyhow::Result<String> {
     Ok(s)
 }
 
+/// The cells both tables share: original cost, doherty's cost and saving, towpath's cost and
+/// saving, both solve times (each cell followed by ` |`).
+fn compared(original: f64, d: &SolveReport, t: &SolveReport) -> String {
+    let save = |c: f64| 100.0 * (original - c) / original;
+    format!(
+        "{original:.0} | {:.0} | {:.1} % | {:.0} | {:.1} % | {} | {} |",
+        d.solution.cost,
+        save(d.solution.cost),
+        t.solution.cost,
+        save(t.solution.cost),
+        ms(d.elapsed.as_secs_f64()),
+        ms(t.elapsed.as_secs_f64()),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -260,19 +275,4 @@ mod tests {
             check(&b.problem, &b.original).unwrap();
         }
     }
-}
-
-/// The cells both tables share: original cost, doherty's cost and saving, towpath's cost and
-/// saving, both solve times (each cell followed by ` |`).
-fn compared(original: f64, d: &SolveReport, t: &SolveReport) -> String {
-    let save = |c: f64| 100.0 * (original - c) / original;
-    format!(
-        "{original:.0} | {:.0} | {:.1} % | {:.0} | {:.1} % | {} | {} |",
-        d.solution.cost,
-        save(d.solution.cost),
-        t.solution.cost,
-        save(t.solution.cost),
-        ms(d.elapsed.as_secs_f64()),
-        ms(t.elapsed.as_secs_f64()),
-    )
 }
