@@ -260,6 +260,34 @@ mod tests {
         assert!(Code::parse("1G").is_none());
     }
 
+    /// Every key of a dialect file has a row in docs/dialect.md, with its default.
+    #[test]
+    fn every_key_is_documented_with_its_default() {
+        let docs = include_str!("../../../docs/dialect.md");
+        let d = Dialect { tow_width: Some(1.0), course_width: Some(1.0), ..Dialect::default() };
+        let toml::Value::Table(t) = toml::from_str::<toml::Value>(&d.to_toml_string()).unwrap() else {
+            panic!("a dialect is a table")
+        };
+        let reference: toml::Value = toml::from_str(&Dialect::default().to_toml_string()).unwrap();
+        assert!(t.len() >= 24, "{t:?}");
+        for k in t.keys() {
+            let row = docs.lines().find(|l| l.starts_with(&format!("| `{k}` |")));
+            let Some(row) = row else { panic!("key {k} is not documented in docs/dialect.md") };
+            // The default column shows the reference value.
+            let default = row.split('|').nth(2).unwrap_or("").trim().trim_matches('`').to_string();
+            match reference.get(k) {
+                Some(v) => {
+                    let shown = match v {
+                        toml::Value::String(s) => format!("\"{s}\""),
+                        other => other.to_string().replace(", ", ","),
+                    };
+                    assert_eq!(default.replace(", ", ","), shown, "default of {k}");
+                }
+                None => assert_eq!(default, "none", "default of {k}"),
+            }
+        }
+    }
+
     #[test]
     fn reference_dialect_round_trips_and_bad_keys_are_named() {
         let d = Dialect::default();
