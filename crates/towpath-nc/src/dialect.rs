@@ -67,6 +67,13 @@ pub struct Dialect {
     pub rapid: Vec<String>,
     /// Codes of feed (linear interpolation) moves.
     pub feed: Vec<String>,
+    /// Codes of clockwise arcs (centre by `I`/`J`/`K` offsets from the start, or radius `R`).
+    /// Arcs are kept only inside on-part blocks, as they are; empty: arcs are refused.
+    pub arc_cw: Vec<String>,
+    /// Codes of counter-clockwise arcs.
+    pub arc_ccw: Vec<String>,
+    /// Plane selection codes for arcs, in the order XY, ZX, YZ (modal; XY at the start).
+    pub arc_planes: Vec<String>,
     /// Absolute distance mode.
     pub absolute: String,
     /// Incremental distance mode.
@@ -123,6 +130,9 @@ impl Default for Dialect {
         Dialect {
             rapid: vec![s("G0")],
             feed: vec![s("G1")],
+            arc_cw: vec![s("G2")],
+            arc_ccw: vec![s("G3")],
+            arc_planes: vec![s("G17"), s("G18"), s("G19")],
             absolute: s("G90"),
             incremental: s("G91"),
             set_position: s("G92"),
@@ -154,6 +164,9 @@ impl Default for Dialect {
 pub(crate) struct Codes {
     pub rapid: Vec<Code>,
     pub feed: Vec<Code>,
+    pub arc_cw: Vec<Code>,
+    pub arc_ccw: Vec<Code>,
+    pub planes: Vec<Code>,
     pub absolute: Code,
     pub incremental: Code,
     pub set_position: Code,
@@ -222,9 +235,20 @@ impl Dialect {
         if self.ply_comment.trim().is_empty() {
             return Err(NcError::Dialect("ply_comment: must not be empty".into()));
         }
+        let any = |key: &str, v: &[String]| -> Result<Vec<Code>, NcError> { v.iter().map(|x| code(key, x)).collect() };
+        let planes = any("arc_planes", &self.arc_planes)?;
+        if planes.len() != 3 {
+            return Err(NcError::Dialect(format!(
+                "arc_planes: give three codes (planes XY, ZX and YZ), not {}",
+                planes.len()
+            )));
+        }
         Ok(Codes {
             rapid: list("rapid", &self.rapid)?,
             feed: list("feed", &self.feed)?,
+            arc_cw: any("arc_cw", &self.arc_cw)?,
+            arc_ccw: any("arc_ccw", &self.arc_ccw)?,
+            planes,
             absolute: code("absolute", &self.absolute)?,
             incremental: code("incremental", &self.incremental)?,
             set_position: code("set_position", &self.set_position)?,

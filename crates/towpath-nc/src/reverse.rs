@@ -94,6 +94,9 @@ fn reverse_span(
         }
         let lexed = a.lexed.clone().unwrap_or_default();
         if let Some(rapid) = a.motion {
+            if a.arc {
+                return Err(format!("line {} is an arc: towpath lays arcs only as they are written, forward", j + 1));
+            }
             if a.unknown {
                 return Err(format!("line {} has words towpath does not know on a move", j + 1));
             }

@@ -30,6 +30,9 @@ pub struct VerifyOptions {
     pub strict_plies: bool,
     /// Also require the courses of each ply in their original order.
     pub keep_ply_order: bool,
+    /// Also require seed 000's precedence sets in order: every course of a set laid before any
+    /// course of the next (the verifier finds the sets on its own, from the footprints).
+    pub seed000_sets: bool,
 }
 
 /// Why an optimized program does not verify.
@@ -169,6 +172,10 @@ pub fn verify_parsed(
     // Precedence.
     let plies_with_courses = orig.plies.iter().filter(|p| !p.courses.is_empty()).count();
     let mut precedence_checked = false;
+    let mut pos = vec![0usize; k];
+    for (i, p) in order.iter().enumerate() {
+        pos[p.course] = i;
+    }
     if plies_with_courses > 1 {
         let width = opts.width.or(dialect.course_width.map(Width::Course)).or(dialect.tow_width.map(Width::Tow));
         let owned;
@@ -187,11 +194,10 @@ pub fn verify_parsed(
             }
         };
         check_precedence(orig, fps, &order)?;
+        if opts.seed000_sets {
+            check_sets(orig, fps, &order)?;
+        }
         precedence_checked = true;
-    }
-    let mut pos = vec![0usize; k];
-    for (i, p) in order.iter().enumerate() {
-        pos[p.course] = i;
     }
     if opts.strict_plies {
         for w in orig.plies.iter().filter(|p| !p.courses.is_empty()).collect::<Vec<_>>().windows(2) {
@@ -615,6 +621,84 @@ fn check_precedence(orig: &Program, fps: &Footprints, order: &[Placement]) -> Re
     Ok(())
 }
 
+/// Seed 000's precedence sets, found here on their own: the plies in program order, each
+/// joining the current set unless one of its courses overlaps a course already in it, else
+/// starting the next set. Returns the set of each course (sets numbered from 0).
+fn sets_of_courses(plies: &[Vec<usize>], fps: &Footprints) -> Vec<usize> {
+    let mut widths: Vec<f64> = fps.courses.iter().flat_map(|f| f.quads.iter().map(|q| q.hw)).collect();
+    widths.sort_by(f64::total_cmp);
+    let cell = widths.get(widths.len() / 2).map_or(10.0, |w| (8.0 * w).max(1e-2));
+    let rows = fps.frame.period().map(|p| ((p / cell).ceil().max(1.0)) as i64);
+    let hcell = match (fps.frame.period(), rows) {
+        (Some(p), Some(r)) => p / r as f64,
+        _ => cell,
+    };
+    let cells_of = |q: &crate::footprint::Quad| {
+        let (lo, hi) = q.bounds();
+        let (i0, i1) = ((lo[0] / cell).floor() as i64, (hi[0] / cell).floor() as i64);
+        let (j0, j1) = ((lo[1] / hcell).floor() as i64, (hi[1] / hcell).floor() as i64);
+        (i0..=i1).flat_map(move |i| {
+            (j0..=j1).map(move |j| match rows {
+                Some(r) => (i, j.rem_euclid(r)),
+                None => (i, j),
+            })
+        })
+    };
+    let mut set_of = vec![0usize; fps.courses.len()];
+    let mut set = 0;
+    // The current set's pieces, by cell.
+    let mut grid: HashMap<(i64, i64), Vec<(usize, usize)>> = HashMap::new();
+    for ply in plies {
+        let meets = ply.iter().any(|&c| {
+            fps.courses[c].quads.iter().any(|q| {
+                cells_of(q).any(|key| {
+                    grid.get(&key).is_some_and(|v| {
+                        v.iter()
+                            .any(|&(x, qx)| crate::precedence::quads_overlap(&fps.frame, q, &fps.courses[x].quads[qx]))
+                    })
+                })
+            })
+        });
+        if meets {
+            set += 1;
+            grid.clear();
+        }
+        for &c in ply {
+            set_of[c] = set;
+            for (qi, q) in fps.courses[c].quads.iter().enumerate() {
+                for key in cells_of(q) {
+                    grid.entry(key).or_default().push((c, qi));
+                }
+            }
+        }
+    }
+    set_of
+}
+
+/// Every course of a seed-000 precedence set must be laid before any course of the next.
+fn check_sets(orig: &Program, fps: &Footprints, order: &[Placement]) -> Result<(), VerifyError> {
+    let plies: Vec<Vec<usize>> = orig.plies.iter().map(|p| p.courses.clone()).collect();
+    let set_of = sets_of_courses(&plies, fps);
+    let mut latest: Option<usize> = None;
+    for p in order {
+        if let Some(l) = latest {
+            if set_of[p.course] < set_of[l] {
+                return Err(VerifyError::Order(format!(
+                    "{} (seed-000 precedence set {}) is laid after {} (set {}): each set must be finished before the next starts",
+                    orig.course_name(p.course),
+                    set_of[p.course] + 1,
+                    orig.course_name(l),
+                    set_of[l] + 1
+                )));
+            }
+        }
+        if latest.is_none_or(|l| set_of[p.course] >= set_of[l]) {
+            latest = Some(p.course);
+        }
+    }
+    Ok(())
+}
+
 /// Motion of a program under every cost model the machine supports; `course_of[c]` maps the
 /// program's course c to the index it is reported under. Lines before `header_end` and from
 /// `footer_start` count as header and footer.
@@ -660,4 +744,51 @@ pub fn measure(
         out.push(m);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::footprint::{Footprint, Frame, Quad};
+    use proptest::prelude::*;
+
+    fn band(a: [f64; 2], b: [f64; 2], w: f64) -> Footprint {
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
+        let q = Quad {
+            c: [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0],
+            u: [d[0] / len, d[1] / len],
+            hl: len / 2.0,
+            hw: w / 2.0 - 0.005,
+        };
+        Footprint { quads: vec![q], moves: vec![q], move_of: vec![0], paths: vec![vec![a, b]] }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// The verifier's own seed-000 sets are the optimizer's (`precedence_sets`), found by
+        /// other code.
+        #[test]
+        fn verifier_sets_agree_with_the_optimizer_s(
+            seed in proptest::collection::vec((0.0f64..400.0, 0.0f64..400.0, 0.0f64..std::f64::consts::PI, 10.0f64..120.0, 4.0f64..30.0), 2..30),
+            per_ply in 1usize..5,
+        ) {
+            let courses: Vec<Footprint> =
+                seed.iter().map(|&(x, y, a, l, w)| band([x, y], [x + l * a.cos(), y + l * a.sin()], w)).collect();
+            let n = courses.len();
+            let plies: Vec<Vec<usize>> = (0..n).collect::<Vec<_>>().chunks(per_ply).map(|c| c.to_vec()).collect();
+            let fps = Footprints { frame: Frame::Plan, courses };
+            let mine = sets_of_courses(&plies, &fps);
+            let theirs = crate::precedence::precedence_sets(&fps, &plies);
+            let mut expect = vec![usize::MAX; n];
+            for (s, ps) in theirs.iter().enumerate() {
+                for &p in ps {
+                    for &c in &plies[p] {
+                        expect[c] = s;
+                    }
+                }
+            }
+            prop_assert_eq!(mine, expect);
+        }
+    }
 }

@@ -276,3 +276,186 @@ fn round_trip_of_this_file_s_program() {
     let order: Vec<Placement> = (0..p.courses.len()).map(|c| Placement { course: c, reversed: false }).collect();
     assert_eq!(rewrite(&p, &order, &gantry(), &d, &[]).unwrap(), text);
 }
+
+/// "Precedence: the seed-000 precedence network ...": when that rule is chosen, the verifier
+/// (and so the optimizer's self-check) requires every course of a precedence set laid before
+/// any course of the next, a stronger rule than the course-level one.
+#[test]
+fn verifier_keeps_seed_000_sets_in_order_when_asked() {
+    let d = Dialect::default();
+    let m = gantry();
+    // Ply 1: two courses far apart (y 0 and y 200). Ply 2: one course over the first. The plies
+    // intersect, so they are two sets; the pad needs only the course under it.
+    let mut text = header();
+    text.push_str("(PLY 1)\n");
+    text.push_str(&course(1, 0.0, 0.0, 400.0));
+    text.push_str(&course(2, 200.0, 0.0, 400.0));
+    text.push_str("(PLY 2)\n");
+    text.push_str(&course(1, 0.0, 100.0, 300.0));
+    text.push_str(footer());
+    let p = parse(&text, &m, &d).unwrap();
+    let order: Vec<Placement> = [0, 2, 1].iter().map(|&c| Placement { course: c, reversed: false }).collect();
+    let out = rewrite(&p, &order, &m, &d, &[]).unwrap();
+    verify(&text, &out, &m, &d, &vopts()).unwrap();
+    let sets = VerifyOptions { seed000_sets: true, ..vopts() };
+    let e = verify(&text, &out, &m, &d, &sets).unwrap_err();
+    assert!(matches!(&e, VerifyError::Order(msg) if msg.contains("set 1") && msg.contains("set 2")), "{e}");
+    // The sets' order itself passes.
+    verify(&text, &text, &m, &d, &sets).unwrap();
+    // The optimizer under `--precedence sets` writes a program that keeps them.
+    let mut o = opts(true);
+    o.afp.precedence = towpath_nc::PrecedenceRule::Sets;
+    let r = optimize(&text, &m, &d, &o).unwrap();
+    assert_eq!(r.afp.sets.len(), 2);
+    verify(&text, &r.text, &m, &d, &sets).unwrap();
+    let last_of_first = r.order.iter().rposition(|pl| pl.course < 2).unwrap();
+    let first_of_second = r.order.iter().position(|pl| pl.course == 2).unwrap();
+    assert!(last_of_first < first_of_second);
+}
+
+/// A course whose on-part block turns through a clockwise half circle (`arc`): along x from
+/// `x0` to `x0 + 100`, then round a centre 50 further on, bulging to `y + 50`.
+fn arc_course(n: usize, y: f64, x0: f64, arc: &str) -> String {
+    let x1 = x0 + 100.0;
+    format!(
+        "(COURSE {n})\nG0 X{x0} Y{y} Z20 C0\nG1 Z0 F1000\nM20\nM60 P3\nG1 X{x1} F3000\n{arc}\nM61 P3\nM21\nG1 Z20\n",
+        arc = arc.replace("{x2}", &(x1 + 100.0).to_string()).replace("{y}", &y.to_string())
+    )
+}
+
+fn arc_program(arc: &str) -> String {
+    let mut s = header();
+    s.push_str("(PLY 1)\n");
+    s.push_str(&course(1, 0.0, 0.0, 400.0));
+    s.push_str(&arc_course(2, 200.0, 0.0, arc));
+    s.push_str(&course(3, 100.0, 0.0, 400.0));
+    s.push_str("(PLY 2)\n");
+    // Over the top of the arc only (the arc reaches y 250 at x 150; its chord stays at y 200).
+    s.push_str(&one_tow(1, 250.0, 130.0, 170.0));
+    s.push_str(&one_tow(2, 0.0, 300.0, 380.0));
+    s.push_str(footer());
+    s
+}
+
+/// G2/G3 arcs inside on-part blocks are on-part motion: parsed as the arc they describe (not
+/// the chord), kept byte for byte, counted in footprints and costs, and only their course's
+/// reversal is refused, naming the line.
+#[test]
+fn arcs_on_part_are_kept_as_written_and_refuse_only_reversal() {
+    let d = Dialect::default();
+    let m = gantry();
+    let arc_line = "G2 X{x2} Y{y} I50 J0";
+    let text = arc_program(arc_line);
+    let written = "G2 X200 Y200 I50 J0";
+    assert!(text.contains(written));
+    let line = text.lines().position(|l| l == written).unwrap() + 1;
+    let p = parse(&text, &m, &d).unwrap();
+    // The arc's pieces lie on its circle (centre 150, 200; radius 50), clockwise over the top,
+    // and each chord stays within a few micrometres of the arc.
+    let pieces: Vec<_> = p.segments.iter().filter(|s| s.line as usize == line - 1).collect();
+    assert!(pieces.len() > 10, "{}", pieces.len());
+    let mut top: f64 = 0.0;
+    for s in &pieces {
+        assert!(s.on_part && s.mask == 3 && !s.rapid);
+        let (a, b) = (p.point(s.from), p.point(s.to));
+        for q in [a, b] {
+            assert!(((q[0] - 150.0).hypot(q[1] - 200.0) - 50.0).abs() < 1e-9, "{q:?}");
+            top = top.max(q[1]);
+        }
+        let mid = [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
+        assert!(50.0 - (mid[0] - 150.0).hypot(mid[1] - 200.0) < 0.005);
+    }
+    assert!((top - 250.0).abs() < 1e-6, "clockwise from the left goes over the top: {top}");
+    // The footprint follows the arc: the pad over its top must come after it.
+    let o = AfpOptions { width: Some(Width::Tow(10.0)), ..AfpOptions::default() };
+    let afp = build_problem(&p, &m, &d, &o).unwrap();
+    let preds: Vec<u32> = afp.problem.precedence().predecessors(towpath_seq::TaskId(3)).iter().map(|t| t.0).collect();
+    assert_eq!(preds, vec![1]);
+    // On-part tool distance: 100 straight + half of a circle of radius 50, to a few µm.
+    let v = verify(&text, &text, &m, &d, &vopts()).unwrap();
+    let (tool, _) = v.motion(CostKind::Tool).unwrap();
+    let laid = 2.0 * 400.0 + 100.0 + 50.0 * std::f64::consts::PI + 40.0 + 80.0;
+    assert!((tool.on_part - laid).abs() < 0.01, "{} vs {laid}", tool.on_part);
+    // Optimized either way, the arc line is kept as written and the output verifies.
+    for bi in [false, true] {
+        let r = optimize(&text, &m, &d, &opts(bi)).unwrap();
+        assert_eq!(r.text.lines().filter(|l| *l == written).count(), 1, "bi={bi}");
+        assert!(r.order.iter().any(|pl| pl.course == 1 && !pl.reversed));
+        verify(&text, &r.text, &m, &d, &vopts()).unwrap();
+        if bi {
+            let (c, why) = &r.afp.not_reversible[0];
+            assert_eq!((*c, r.afp.not_reversible.len()), (1, 1));
+            assert!(why.contains(&format!("line {line}")) && why.contains("arc"), "{why}");
+            assert!(r.verification.reversed > 0, "the other courses still reverse");
+        }
+    }
+    // Reversing that course on purpose is refused, naming the line.
+    let e = towpath_nc::reverse_course(&p, 1, &m, &d).unwrap_err();
+    assert!(e.contains(&format!("line {line}")), "{e}");
+}
+
+/// The same arc given by its radius, and the long way round with a negative radius; a
+/// counter-clockwise arc goes under; arcs that cannot be, or that are off-part, are refused
+/// with their line.
+#[test]
+fn arc_forms_and_arc_errors() {
+    let d = Dialect::default();
+    let m = gantry();
+    let points = |arc: &str| -> Vec<Vec<f64>> {
+        let text = arc_program(arc);
+        let p = parse(&text, &m, &d).unwrap();
+        let line = p.lines.iter().position(|l| l.starts_with("G2 ") || l.starts_with("G3 ")).unwrap();
+        p.segments.iter().filter(|s| s.line as usize == line).map(|s| p.point(s.to).to_vec()).collect()
+    };
+    let by_centre = points("G2 X{x2} Y{y} I50 J0");
+    let by_radius = points("G2 X{x2} Y{y} R50");
+    assert_eq!(by_centre.len(), by_radius.len());
+    for (a, b) in by_centre.iter().zip(&by_radius) {
+        assert!((a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6);
+    }
+    let under = points("G3 X{x2} Y{y} I50 J0");
+    assert!(under.iter().all(|q| q[1] <= 200.0 + 1e-9) && under.iter().any(|q| q[1] < 151.0));
+    // A quarter turn from (100, 200) to (150, 250): R50 short way (centre 150, 200), R-50 the
+    // three-quarter way round (centre 100, 250).
+    let short = points("G2 X150 Y250 R50");
+    let long = points("G2 X150 Y250 R-50");
+    assert!(long.len() > 2 * short.len());
+    assert!(short.iter().all(|q| ((q[0] - 150.0).hypot(q[1] - 200.0) - 50.0).abs() < 1e-9));
+    assert!(long.iter().all(|q| ((q[0] - 100.0).hypot(q[1] - 250.0) - 50.0).abs() < 1e-9));
+    // A full circle back to the start.
+    let full = points("G2 X100 Y{y} I50");
+    assert!(
+        full.iter().any(|q| q[0] > 199.99) && full.iter().any(|q| q[1] > 249.99) && full.iter().any(|q| q[1] < 150.01)
+    );
+    assert!(full.len() + 1 >= 2 * by_centre.len());
+    for (arc, why) in [
+        ("G2 X{x2} Y{y} I40 J0", "not on its circle"),
+        ("G2 X{x2} Y{y}", "centre"),
+        ("G2 X{x2} Y{y} R20", "shorter than half"),
+        ("G2 X{x2} Y{y} R50 I50", "both"),
+    ] {
+        let text = arc_program(arc);
+        let bad = arc.replace("{x2}", "200").replace("{y}", "200");
+        let line = text.lines().position(|l| l == bad).unwrap() + 1;
+        match parse(&text, &m, &d).unwrap_err() {
+            NcError::Line { line: l, message } => {
+                assert_eq!(l, line, "{arc}");
+                assert!(message.contains(why), "{arc}: {message}");
+            }
+            e => panic!("{arc}: expected a line error, got {e}"),
+        }
+    }
+    // Off-part (the approach written as an arc): refused, naming the line.
+    let text = arc_program("G2 X{x2} Y{y} I50 J0").replacen("G1 Z0 F1000\n", "G1 Z0 F1000\nG3 X10 Y0 I5\n", 1);
+    match parse(&text, &m, &d).unwrap_err() {
+        NcError::Line { line, message } => {
+            assert_eq!(text.lines().nth(line - 1), Some("G3 X10 Y0 I5"));
+            assert!(message.contains("outside a course's on-part block"), "{message}");
+        }
+        e => panic!("expected a line error, got {e}"),
+    }
+    // A dialect without arcs refuses them as before.
+    let no_arcs = Dialect { arc_cw: Vec::new(), arc_ccw: Vec::new(), ..Dialect::default() };
+    let e = parse(&arc_program("G2 X{x2} Y{y} I50 J0"), &m, &no_arcs).unwrap_err();
+    assert!(e.to_string().contains("G2 with axis words"), "{e}");
+}
