@@ -459,3 +459,32 @@ fn arc_forms_and_arc_errors() {
     let e = parse(&arc_program("G2 X{x2} Y{y} I50 J0"), &m, &no_arcs).unwrap_err();
     assert!(e.to_string().contains("G2 with axis words"), "{e}");
 }
+
+/// The arc plane is modal state like the others: a course whose arc relies on the XY plane,
+/// laid after a course that switched to ZX, is entered with the plane restored, and without
+/// that line the verifier sees a different arc.
+#[test]
+fn the_arc_plane_is_restored_before_a_course_that_relies_on_it() {
+    let d = Dialect::default();
+    let m = gantry();
+    let mut text = header();
+    text.push_str("(PLY 1)\n");
+    text.push_str(&arc_course(1, 0.0, 0.0, "G2 X{x2} Y{y} I50 J0"));
+    // Course 2 turns to the ZX plane for a hump over x 100..200 (counter-clockwise seen from +Y
+    // goes up in Z).
+    text.push_str(&arc_course(2, 300.0, 0.0, "G18\nG3 X{x2} Z0 I50 K0"));
+    text.push_str(footer());
+    let p = parse(&text, &m, &d).unwrap();
+    let hump = p.segments.iter().filter(|s| p.lines[s.line as usize].starts_with("G3")).map(|s| p.point(s.to)[2]);
+    assert!((hump.fold(0.0, f64::max) - 50.0).abs() < 1e-6);
+    let order = [Placement { course: 1, reversed: false }, Placement { course: 0, reversed: false }];
+    let out = rewrite(&p, &order, &m, &d, &[]).unwrap();
+    let restore = out.lines().position(|l| l == "G17").expect("the XY plane is restored");
+    let arc = out.lines().position(|l| l == "G2 X200 Y0 I50 J0").unwrap();
+    let g18 = out.lines().position(|l| l == "G18").unwrap();
+    assert!(g18 < restore && restore < arc, "{out}");
+    verify(&text, &out, &m, &d, &vopts()).unwrap();
+    let without: Vec<&str> = out.lines().filter(|l| *l != "G17").collect();
+    let e = verify(&text, &without.join("\n"), &m, &d, &vopts()).unwrap_err();
+    assert!(matches!(e, VerifyError::Unmatched { .. }), "{e}");
+}
