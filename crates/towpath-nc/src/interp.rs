@@ -331,7 +331,12 @@ impl<'a> Interp<'a> {
             self.m.plane = p;
             out.modal = true;
         }
-        let arc_move = self.m.arc.is_some() && !axes.is_empty() && !set_pos && !passthrough && other_g.is_none();
+        // An arc: axis words in arc mode, or centre words alone (a full circle where it stands).
+        let arc_move = self.m.arc.is_some()
+            && (!axes.is_empty() || !arc_words.is_empty())
+            && !set_pos
+            && !passthrough
+            && other_g.is_none();
         if !arc_move && !arc_words.is_empty() {
             // Centre or radius words on a line that is no arc: words towpath does not know.
             out.unknown = true;
@@ -390,7 +395,7 @@ impl<'a> Interp<'a> {
         } else if !axes.is_empty() && passthrough {
             // A dwell or similar: the words are not positions.
             out.unknown = true;
-        } else if !axes.is_empty() {
+        } else if !axes.is_empty() || arc_move {
             if let Some(g) = other_g {
                 return Err(NcError::line(
                     n,
@@ -767,8 +772,13 @@ mod tests {
         assert!(b.arc && b.path.iter().all(|p| p[0] > -1e-9 && p[2] > -1e-9));
         let c = it.apply(6, "X0 Z10 I-10").unwrap();
         assert!(c.arc);
+        // Centre words alone in arc mode: a full circle from where the tool stands.
+        let full = it.apply(7, "K-5").unwrap();
+        assert!(full.arc && full.motion == Some(false) && full.path.len() > 8);
+        assert!(full.path.iter().all(|p| (p[0].hypot(p[2] - 5.0) - 5.0).abs() < 1e-9));
+        assert_eq!(it.m.prog, vec![0.0, 0.0, 10.0]);
         // A machine without the plane's axes cannot lay the arc.
-        it.apply(7, "G19").unwrap();
+        it.apply(8, "G19").unwrap();
         let m2 = Machine::new("m", vec![Axis::new("X", AxisKind::Linear), Axis::new("Y", AxisKind::Linear)]).unwrap();
         let mut it2 = Interp::new(&d, &m2).unwrap();
         it2.apply(0, "M20").unwrap();
