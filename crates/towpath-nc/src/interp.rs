@@ -413,7 +413,8 @@ impl<'a> Interp<'a> {
                 self.events(n, &events)?;
                 out.before = events.clone();
             }
-            let start = self.m.clone();
+            // The state where an arc starts (straight moves need none).
+            let start = if arc_move { Some((self.m.prog.clone(), self.m.phys.clone())) } else { None };
             if arc_move {
                 let laying = if self.codes.contact.is_some() { self.m.contact } else { self.m.mask != 0 };
                 if !laying {
@@ -444,9 +445,9 @@ impl<'a> Interp<'a> {
                 }
             }
             out.motion = Some(rapid);
-            if let Some(cw) = self.m.arc.filter(|_| arc_move) {
+            if let (Some(cw), Some((prog, phys))) = (self.m.arc, &start) {
                 out.arc = true;
-                out.path = self.arc_path(n, &start, cw, &arc_words)?;
+                out.path = self.arc_path(n, prog, phys, cw, &arc_words)?;
             }
             if timing == EventTiming::After {
                 self.events(n, &events)?;
@@ -463,7 +464,14 @@ impl<'a> Interp<'a> {
 
     /// The physical states an arc from `start` to the current state passes through (its end
     /// excluded), every chord within [`ARC_CHORD_TOLERANCE`] of the arc.
-    fn arc_path(&self, n: usize, start: &Modal, cw: bool, words: &[&Word]) -> Result<Vec<Vec<f64>>, NcError> {
+    fn arc_path(
+        &self,
+        n: usize,
+        start_prog: &[f64],
+        start_phys: &[f64],
+        cw: bool,
+        words: &[&Word],
+    ) -> Result<Vec<Vec<f64>>, NcError> {
         let (labels, centre) = PLANES[self.m.plane as usize % 3];
         let plane_name: String = labels.iter().collect();
         let mut idx = [0usize; 2];
@@ -479,7 +487,7 @@ impl<'a> Interp<'a> {
             }
         }
         let word = |l: char| words.iter().find(|w| w.letter == l).map(|w| w.value);
-        let (s, e) = ([start.prog[idx[0]], start.prog[idx[1]]], [self.m.prog[idx[0]], self.m.prog[idx[1]]]);
+        let (s, e) = ([start_prog[idx[0]], start_prog[idx[1]]], [self.m.prog[idx[0]], self.m.prog[idx[1]]]);
         let chord = ((e[0] - s[0]).powi(2) + (e[1] - s[1]).powi(2)).sqrt();
         let offsets = [word(centre[0]), word(centre[1])];
         let c = match (word('R'), offsets) {
@@ -541,10 +549,10 @@ impl<'a> Interp<'a> {
             let t = k as f64 / pieces as f64;
             let a = a0 + dir * sweep * t;
             let rt = r0 + (r1 - r0) * t;
-            let mut p: Vec<f64> = start.phys.iter().zip(&self.m.phys).map(|(x, y)| x + (y - x) * t).collect();
+            let mut p: Vec<f64> = start_phys.iter().zip(&self.m.phys).map(|(x, y)| x + (y - x) * t).collect();
             for (k2, v) in [c[0] + rt * a.cos(), c[1] + rt * a.sin()].into_iter().enumerate() {
                 let i = idx[k2];
-                p[i] = v + (start.phys[i] - start.prog[i]);
+                p[i] = v + (start_phys[i] - start_prog[i]);
             }
             path.push(p);
         }
