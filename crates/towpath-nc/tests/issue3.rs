@@ -389,6 +389,11 @@ fn arcs_on_part_are_kept_as_written_and_refuse_only_reversal() {
             assert!(r.verification.reversed > 0, "the other courses still reverse");
         }
     }
+    // An arc turned the other way round (same ends, same centre) is other on-part motion.
+    let r = optimize(&text, &m, &d, &opts(false)).unwrap();
+    let flipped = r.text.replacen(written, "G3 X200 Y200 I50 J0", 1);
+    let e = verify(&text, &flipped, &m, &d, &vopts()).unwrap_err();
+    assert!(matches!(e, VerifyError::Unmatched { .. }), "{e}");
     // Reversing that course on purpose is refused, naming the line.
     let e = towpath_nc::reverse_course(&p, 1, &m, &d).unwrap_err();
     assert!(e.contains(&format!("line {line}")), "{e}");
