@@ -166,7 +166,7 @@ pub fn verify_parsed(
     }
     let tol = (0.5 * 10f64.powi(-(dialect.decimals as i32))).max(1e-6);
     check_header_footer(orig, opt)?;
-    let (order, rewritten) = match_courses(orig, opt, machine, tol)?;
+    let (order, rewritten) = match_courses(orig, opt, machine, dialect, tol)?;
     check_kept_lines(orig, opt, &order, &rewritten, dialect)?;
 
     // Precedence.
@@ -248,17 +248,74 @@ pub fn verify_parsed(
 struct SpanMotion {
     points: Vec<Vec<f64>>,
     moves: Vec<(bool, u64, f64)>,
+    /// Off-part moves before the first laid one (the approach).
+    lead: usize,
+    /// Off-part moves after the last laid one (the retract).
+    trail: usize,
+    /// The approach block has fewer moves than the dialect's `approach_moves` (nothing moved
+    /// before it), so a program that moves before the course reads that move as its approach.
+    short_approach: bool,
+    /// The retract block has fewer moves than `retract_moves`, likewise.
+    short_retract: bool,
 }
 
-fn span_motion(p: &Program, c: usize) -> SpanMotion {
+impl SpanMotion {
+    /// The moves and points without `front` moves at the start and `back` at the end.
+    fn trimmed(&self, front: usize, back: usize) -> (&[Vec<f64>], &[(bool, u64, f64)]) {
+        let n = self.moves.len();
+        if front + back > n {
+            return (&[], &[]);
+        }
+        (&self.points[front..=n - back], &self.moves[front..n - back])
+    }
+}
+
+fn span_motion(p: &Program, c: usize, dialect: &Dialect) -> SpanMotion {
     let course = &p.courses[c];
     let mut points = vec![course.span_start.phys.clone()];
     let mut moves = Vec::new();
+    let (mut approach, mut retract) = (0, 0);
     for s in &p.segments[course.segments.clone()] {
         points.push(p.point(s.to).to_vec());
         moves.push((s.on_part, s.mask, s.feed));
+        if (s.line as usize) < course.on_part.start {
+            approach += 1;
+        } else if (s.line as usize) >= course.on_part.end {
+            retract += 1;
+        }
     }
-    SpanMotion { points, moves }
+    let first = moves.iter().position(|m| m.0);
+    let lead = first.unwrap_or(moves.len());
+    let trail = moves.iter().rposition(|m| m.0).map_or(0, |l| moves.len() - 1 - l);
+    SpanMotion {
+        points,
+        moves,
+        lead,
+        trail,
+        short_approach: approach < dialect.approach_moves,
+        short_retract: retract < dialect.retract_moves,
+    }
+}
+
+/// The point where a course starts laying (forward) or ends laying, for finding candidates.
+fn laying_point(p: &Program, c: usize, end: bool) -> &[f64] {
+    let mut laid = p.on_part_segments(c);
+    let found = if end { laid.last().map(|s| s.to) } else { laid.next().map(|s| s.from) };
+    match found {
+        Some(i) => p.point(i),
+        None if end => &p.courses[c].exit.phys,
+        None => &p.courses[c].span_start.phys,
+    }
+}
+
+/// How many moves of an optimized course to leave out at its start and end before comparing
+/// it with the original's: the transit moves it read as approach or retract where the
+/// original's block was short (`front_short`, `back_short`: the original's blocks that become
+/// the optimized course's approach and retract).
+fn extra(b: &SpanMotion, front: (usize, bool), back: (usize, bool)) -> (usize, usize) {
+    let f = if front.1 { b.lead.saturating_sub(front.0) } else { 0 };
+    let k = if back.1 { b.trail.saturating_sub(back.0) } else { 0 };
+    (f, k)
 }
 
 fn same_value(machine: &Machine, i: usize, a: f64, b: f64, turn: f64, tol: f64) -> bool {
@@ -276,19 +333,20 @@ fn same_feed(a: f64, b: f64) -> bool {
 }
 
 /// Checks that `opt`'s course `kc` is `orig`'s course `oc` laid forward.
-fn is_forward(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Machine, tol: f64) -> Result<(), String> {
-    let (a, b) = (span_motion(orig, oc), span_motion(opt, kc));
-    if a.moves.len() != b.moves.len() {
-        return Err(format!("{} moves instead of {}", b.moves.len(), a.moves.len()));
+fn is_forward(a: &SpanMotion, b: &SpanMotion, machine: &Machine, tol: f64) -> Result<(), String> {
+    let (front, back) = extra(b, (a.lead, a.short_approach), (a.trail, a.short_retract));
+    let (bp, bm) = b.trimmed(front, back);
+    if a.moves.len() != bm.len() {
+        return Err(format!("{} moves instead of {}", bm.len(), a.moves.len()));
     }
-    for (i, (pa, pb)) in a.points.iter().zip(&b.points).enumerate() {
+    for (i, (pa, pb)) in a.points.iter().zip(bp).enumerate() {
         for ax in 0..machine.dim() {
             if !same_value(machine, ax, pa[ax], pb[ax], 0.0, tol) {
                 return Err(format!("point {i}: axis {} is {} instead of {}", machine.axes[ax].label, pb[ax], pa[ax]));
             }
         }
     }
-    for (i, (ma, mb)) in a.moves.iter().zip(&b.moves).enumerate() {
+    for (i, (ma, mb)) in a.moves.iter().zip(bm).enumerate() {
         if ma.0 != mb.0 || ma.1 != mb.1 || (ma.0 && !same_feed(ma.2, mb.2)) {
             return Err(format!("move {i}: contact, tows or feed differ"));
         }
@@ -297,15 +355,17 @@ fn is_forward(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Mac
 }
 
 /// Checks that `opt`'s course `kc` is `orig`'s course `oc` legally reversed.
-fn is_reversal(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Machine, tol: f64) -> Result<(), String> {
-    let (a, b) = (span_motion(orig, oc), span_motion(opt, kc));
+fn is_reversal(a: &SpanMotion, b: &SpanMotion, machine: &Machine, tol: f64) -> Result<(), String> {
+    // Reversed, the original's retract leads and its approach trails.
+    let (front, back) = extra(b, (a.trail, a.short_retract), (a.lead, a.short_approach));
+    let (bp, bm) = b.trimmed(front, back);
     let n = a.moves.len();
-    if n != b.moves.len() {
-        return Err(format!("{} moves instead of {}", b.moves.len(), n));
+    if n != bm.len() {
+        return Err(format!("{} moves instead of {}", bm.len(), n));
     }
     let heading = machine.heading_axis();
     for i in 0..=n {
-        let (pa, pb) = (&a.points[n - i], &b.points[i]);
+        let (pa, pb) = (&a.points[n - i], &bp[i]);
         for ax in 0..machine.dim() {
             let turn = if Some(ax) == heading { 180.0 } else { 0.0 };
             if !same_value(machine, ax, pa[ax], pb[ax], turn, tol) {
@@ -321,7 +381,7 @@ fn is_reversal(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Ma
         }
     }
     for i in 0..n {
-        let (ma, mb) = (&a.moves[n - 1 - i], &b.moves[i]);
+        let (ma, mb) = (&a.moves[n - 1 - i], &bm[i]);
         if ma.0 != mb.0 {
             return Err(format!("reversed move {i}: roller contact differs from the original's move {}", n - 1 - i));
         }
@@ -397,6 +457,7 @@ fn match_courses(
     orig: &Program,
     opt: &Program,
     machine: &Machine,
+    dialect: &Dialect,
     tol: f64,
 ) -> Result<(Vec<Placement>, Vec<bool>), VerifyError> {
     let k = orig.courses.len();
@@ -407,9 +468,11 @@ fn match_courses(
     let mut by_end: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
     let mut by_start: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
     for c in (0..k).rev() {
-        let key: Vec<i64> = point_cell(machine, &orig.courses[c].exit.phys).iter().map(|x| x.0).collect();
+        // Keyed by where laying starts and ends: the approach and retract around it may have
+        // taken in transit moves in the optimized program (see `extra`).
+        let key: Vec<i64> = point_cell(machine, laying_point(orig, c, true)).iter().map(|x| x.0).collect();
         by_end.entry(key).or_default().push(c);
-        let key: Vec<i64> = point_cell(machine, &orig.courses[c].span_start.phys).iter().map(|x| x.0).collect();
+        let key: Vec<i64> = point_cell(machine, laying_point(orig, c, false)).iter().map(|x| x.0).collect();
         by_start.entry(key).or_default().push(c);
     }
     let near = |map: &HashMap<Vec<i64>, Vec<usize>>, p: &[f64]| -> Vec<usize> {
@@ -426,6 +489,7 @@ fn match_courses(
     let mut rewritten = Vec::with_capacity(k);
     for kc in 0..k {
         let text = span_text(opt, kc);
+        let b = span_motion(opt, kc, dialect);
         let mut found = None;
         let mut detail = String::new();
         if let Some(cands) = by_text.get(&text) {
@@ -433,7 +497,7 @@ fn match_courses(
                 if used[oc] {
                     continue;
                 }
-                match is_forward(orig, oc, opt, kc, machine, tol) {
+                match is_forward(&span_motion(orig, oc, dialect), &b, machine, tol) {
                     Ok(()) => {
                         found = Some(Placement { course: oc, reversed: false });
                         break;
@@ -443,10 +507,10 @@ fn match_courses(
             }
         }
         let by_text = found.is_some();
-        let start = &opt.courses[kc].span_start.phys;
+        let start = laying_point(opt, kc, false);
         if found.is_none() {
             for oc in near(&by_start, start) {
-                if !used[oc] && is_forward(orig, oc, opt, kc, machine, tol).is_ok() {
+                if !used[oc] && is_forward(&span_motion(orig, oc, dialect), &b, machine, tol).is_ok() {
                     found = Some(Placement { course: oc, reversed: false });
                     break;
                 }
@@ -455,14 +519,14 @@ fn match_courses(
         if found.is_none() {
             let cands = near(&by_end, start);
             if cands.is_empty() && detail.is_empty() {
-                detail = ": no course of the original ends where it starts".into();
+                detail = ": no course of the original stops laying where it starts".into();
             }
             {
                 for &oc in cands.iter() {
                     if used[oc] {
                         continue;
                     }
-                    match is_reversal(orig, oc, opt, kc, machine, tol) {
+                    match is_reversal(&span_motion(orig, oc, dialect), &b, machine, tol) {
                         Ok(()) => {
                             found = Some(Placement { course: oc, reversed: true });
                             break;

@@ -493,3 +493,51 @@ fn the_arc_plane_is_restored_before_a_course_that_relies_on_it() {
     let e = verify(&text, &without.join("\n"), &m, &d, &vopts()).unwrap_err();
     assert!(matches!(e, VerifyError::Unmatched { .. }), "{e}");
 }
+
+/// Courses with fewer approach or retract moves than the dialect's counts (the first course
+/// laid from home with no move before it; courses joined by a single move, which the dialect
+/// gives to the retract): moved elsewhere, such a course is preceded or followed by a
+/// regenerated transit that, read again, counts as its approach or retract. The verifier
+/// accepts that (it is off-part motion), and still checks everything laid. Found by the
+/// `afp_program` fuzz target.
+#[test]
+fn courses_with_short_approach_or_retract_blocks_verify_when_moved() {
+    let d = Dialect::default();
+    let m = gantry();
+    let lay = |y: f64| format!("M20\nM60 P1\nG1 X400 Y{y} F3000\nM61 P1\nM21\n");
+    // Course 1 starts where the machine stands (home); each later course is reached by one
+    // move, which is the previous course's retract; the last course has no retract.
+    let mut text = String::from("G90\n(PLY 1)\n(COURSE 1)\nG1 F1000\n");
+    text.push_str(&lay(0.0));
+    for (n, y) in [(2, 80.0), (3, 40.0), (4, 120.0)] {
+        text.push_str(&format!("G0 X0 Y{y} Z0\n(COURSE {n})\n"));
+        text.push_str(&lay(y));
+    }
+    text.push_str("M30\n");
+    let p = parse(&text, &m, &d).unwrap();
+    assert_eq!(p.courses.len(), 4);
+    assert!(p.courses.iter().all(|c| c.approach().is_empty()), "no course has an approach move");
+    // Any order, forward or reversed: the rewrite verifies, and a changed laid point does not.
+    let rev: Vec<_> = (0..4).map(|c| towpath_nc::reverse_course(&p, c, &m, &d).ok()).collect();
+    assert!(rev.iter().all(Option::is_some));
+    for order in [[(2, false), (0, false), (3, false), (1, false)], [(3, true), (1, false), (0, true), (2, true)]] {
+        let order: Vec<Placement> = order.iter().map(|&(course, reversed)| Placement { course, reversed }).collect();
+        let out = rewrite(&p, &order, &m, &d, &rev).unwrap();
+        let v = verify(&text, &out, &m, &d, &vopts()).unwrap();
+        assert_eq!(v.order, order);
+        let (b, a) = v.motion(CostKind::Axis).unwrap();
+        assert!((a.on_part - b.on_part).abs() < 1e-9);
+        let bad = out.replacen("X400 Y40", "X400 Y41", 1);
+        assert_ne!(bad, out);
+        assert!(verify(&text, &bad, &m, &d, &vopts()).is_err());
+    }
+    // The optimizer's self-check accepts its own output too, in either dialect reading.
+    for dialect in [d.clone(), Dialect { retract_moves: 0, ..Dialect::default() }] {
+        for bi in [false, true] {
+            let o = optimize(&text, &m, &dialect, &opts(bi)).unwrap();
+            let v = verify(&text, &o.text, &m, &dialect, &vopts()).unwrap();
+            let (b, a) = v.motion(CostKind::Axis).unwrap();
+            assert!(a.off_part() <= b.off_part() + 1e-9);
+        }
+    }
+}
