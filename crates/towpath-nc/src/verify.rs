@@ -244,10 +244,13 @@ pub fn verify_parsed(
     })
 }
 
+/// One move of a span: (on-part, tows on, feed).
+type SpanMove = (bool, u64, f64);
+
 /// The span of a course as points (physical values), with each move's (on-part, tows, feed).
 struct SpanMotion {
     points: Vec<Vec<f64>>,
-    moves: Vec<(bool, u64, f64)>,
+    moves: Vec<SpanMove>,
     /// Off-part moves before the first laid one (the approach).
     lead: usize,
     /// Off-part moves after the last laid one (the retract).
@@ -261,7 +264,7 @@ struct SpanMotion {
 
 impl SpanMotion {
     /// The moves and points without `front` moves at the start and `back` at the end.
-    fn trimmed(&self, front: usize, back: usize) -> (&[Vec<f64>], &[(bool, u64, f64)]) {
+    fn trimmed(&self, front: usize, back: usize) -> (&[Vec<f64>], &[SpanMove]) {
         let n = self.moves.len();
         if front + back > n {
             return (&[], &[]);
