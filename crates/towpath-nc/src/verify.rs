@@ -582,6 +582,9 @@ fn check_kept_lines(
         *have.entry(l.trim_end_matches('\r')).or_default() += 1;
     }
     let mut need: Vec<(usize, String)> = Vec::new();
+    // Text kept from transit lines: on a line of its own, or, where the transit itself was
+    // kept (the original order), on the original line.
+    let mut kept: Vec<(usize, &str)> = Vec::new();
     for j in (0..orig.header_end).chain(orig.footer_start..orig.lines.len()) {
         need.push((j, orig.lines[j].clone()));
     }
@@ -589,7 +592,7 @@ fn check_kept_lines(
         for item in course.pre_before.iter().chain(&course.pre_after).chain(&course.post) {
             match item {
                 Item::Line(j) => need.push((*j, orig.lines[*j].clone())),
-                Item::Kept(j, t) => need.push((*j, t.clone())),
+                Item::Kept(j, t) => kept.push((*j, t)),
             }
         }
     }
@@ -605,6 +608,19 @@ fn check_kept_lines(
         match have.get_mut(t) {
             Some(n) if *n > 0 => *n -= 1,
             _ => return Err(VerifyError::LostLine { line: j + 1, text: t.to_string() }),
+        }
+    }
+    for (j, t) in kept {
+        let whole = orig.lines[j].trim_end_matches('\r');
+        let found = [whole, t].into_iter().any(|x| match have.get_mut(x) {
+            Some(n) if *n > 0 => {
+                *n -= 1;
+                true
+            }
+            _ => false,
+        });
+        if !found {
+            return Err(VerifyError::LostLine { line: j + 1, text: t.to_string() });
         }
     }
     Ok(())

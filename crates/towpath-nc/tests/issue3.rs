@@ -541,3 +541,33 @@ fn courses_with_short_approach_or_retract_blocks_verify_when_moved() {
         }
     }
 }
+
+/// A transit line with a comment: rewritten, the comment stays on a line of its own; in the
+/// original order (or when the optimizer finds nothing cheaper and returns the input) the
+/// transit line itself keeps it, and the program still verifies against itself. Found by the
+/// `afp_program` fuzz target.
+#[test]
+fn comments_on_transit_lines_verify_in_the_original_order() {
+    let d = Dialect::default();
+    let m = gantry();
+    let text = program().replacen("G0 X0 Y80 Z20 C0\n", "G0 X0 Y80 Z20 C0 (to course 2)\n", 1);
+    assert_ne!(text, program());
+    verify(&text, &text, &m, &d, &vopts()).unwrap();
+    let o = optimize(&text, &m, &d, &opts(true)).unwrap();
+    assert!(o.text.lines().any(|l| l == "(to course 2)"));
+    verify(&text, &o.text, &m, &d, &vopts()).unwrap();
+    // The original order is the input itself.
+    let mut keep = opts(false);
+    keep.afp.keep_ply_order = true;
+    keep.afp.precedence = towpath_nc::PrecedenceRule::Plies;
+    let single = format!("{}(PLY 1)\n{}{}", header(), course(1, 0.0, 0.0, 400.0), footer()).replacen(
+        "G0 X0 Y0 Z20 C0\n",
+        "G0 X0 Y0 Z20 C0 (first)\n",
+        1,
+    );
+    let o = optimize(&single, &m, &d, &keep).unwrap();
+    assert_eq!(o.text, single);
+    // Losing the comment is still caught.
+    let lost = o.text.replacen(" (first)", "", 1);
+    assert!(matches!(verify(&single, &lost, &m, &d, &vopts()).unwrap_err(), VerifyError::LostLine { .. }));
+}
