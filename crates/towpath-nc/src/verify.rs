@@ -166,7 +166,7 @@ pub fn verify_parsed(
     }
     let tol = (0.5 * 10f64.powi(-(dialect.decimals as i32))).max(1e-6);
     check_header_footer(orig, opt)?;
-    let (order, rewritten) = match_courses(orig, opt, machine, dialect, tol)?;
+    let (order, rewritten) = match_courses(orig, opt, machine, tol)?;
     check_kept_lines(orig, opt, &order, &rewritten, dialect)?;
 
     // Precedence.
@@ -244,10 +244,11 @@ pub fn verify_parsed(
     })
 }
 
-/// One move of a span: (on-part, tows on, feed).
+/// One move: (on-part, tows on, feed).
 type SpanMove = (bool, u64, f64);
 
-/// The span of a course as points (physical values), with each move's (on-part, tows, feed).
+/// Consecutive moves of a program as points (physical values), with each move's (on-part,
+/// tows, feed).
 struct SpanMotion {
     points: Vec<Vec<f64>>,
     moves: Vec<SpanMove>,
@@ -255,49 +256,46 @@ struct SpanMotion {
     lead: usize,
     /// Off-part moves after the last laid one (the retract).
     trail: usize,
-    /// The approach block has fewer moves than the dialect's `approach_moves` (nothing moved
-    /// before it), so a program that moves before the course reads that move as its approach.
-    short_approach: bool,
-    /// The retract block has fewer moves than `retract_moves`, likewise.
-    short_retract: bool,
 }
 
-impl SpanMotion {
-    /// The moves and points without `front` moves at the start and `back` at the end.
-    fn trimmed(&self, front: usize, back: usize) -> (&[Vec<f64>], &[SpanMove]) {
-        let n = self.moves.len();
-        if front + back > n {
-            return (&[], &[]);
-        }
-        (&self.points[front..=n - back], &self.moves[front..n - back])
-    }
-}
-
-fn span_motion(p: &Program, c: usize, dialect: &Dialect) -> SpanMotion {
-    let course = &p.courses[c];
-    let mut points = vec![course.span_start.phys.clone()];
-    let mut moves = Vec::new();
-    let (mut approach, mut retract) = (0, 0);
-    for s in &p.segments[course.segments.clone()] {
+/// The moves `segs` of `p`, starting from `start` if there are none.
+fn motion_of(p: &Program, segs: std::ops::Range<usize>, start: &[f64]) -> SpanMotion {
+    let first = p.segments.get(segs.start).filter(|_| !segs.is_empty());
+    let mut points = vec![first.map_or_else(|| start.to_vec(), |s| p.point(s.from).to_vec())];
+    let mut moves = Vec::with_capacity(segs.len());
+    for s in &p.segments[segs] {
         points.push(p.point(s.to).to_vec());
         moves.push((s.on_part, s.mask, s.feed));
-        if (s.line as usize) < course.on_part.start {
-            approach += 1;
-        } else if (s.line as usize) >= course.on_part.end {
-            retract += 1;
-        }
     }
-    let first = moves.iter().position(|m| m.0);
-    let lead = first.unwrap_or(moves.len());
+    let lead = moves.iter().position(|m| m.0).unwrap_or(moves.len());
     let trail = moves.iter().rposition(|m| m.0).map_or(0, |l| moves.len() - 1 - l);
-    SpanMotion {
-        points,
-        moves,
-        lead,
-        trail,
-        short_approach: approach < dialect.approach_moves,
-        short_retract: retract < dialect.retract_moves,
+    SpanMotion { points, moves, lead, trail }
+}
+
+/// The moves of course `c`'s span.
+fn span_motion(p: &Program, c: usize) -> SpanMotion {
+    let course = &p.courses[c];
+    motion_of(p, course.segments.clone(), &course.span_start.phys)
+}
+
+/// The moves of optimized course `kc` to compare with an original course: its laid moves with
+/// the `lead` moves before them and the `trail` moves after, wherever reading the optimized
+/// program put those. (Where an original approach or retract block is short, because nothing
+/// moved before the course or one move joined two courses, the regenerated transit, or the
+/// next course's approach, reads as part of it; such moves are off-part all the same.) `None`
+/// if the program has not that many moves there. A course that lays no move is its span.
+fn window(p: &Program, kc: usize, lead: usize, trail: usize) -> Option<SpanMotion> {
+    let segs = p.courses[kc].segments.clone();
+    let first = segs.clone().find(|&i| p.segments[i].on_part);
+    let last = segs.clone().rev().find(|&i| p.segments[i].on_part);
+    let (Some(f), Some(l)) = (first, last) else {
+        return Some(span_motion(p, kc));
+    };
+    let (lo, hi) = (f.checked_sub(lead)?, l + 1 + trail);
+    if hi > p.segments.len() {
+        return None;
     }
+    Some(motion_of(p, lo..hi, &p.courses[kc].span_start.phys))
 }
 
 /// The point where a course starts laying (forward) or ends laying, for finding candidates.
@@ -311,45 +309,23 @@ fn laying_point(p: &Program, c: usize, end: bool) -> &[f64] {
     }
 }
 
-/// How many moves of an optimized course to leave out at its start and end before comparing
-/// it with the original's: the transit moves it read as approach or retract where the
-/// original's block was short (`front_short`, `back_short`: the original's blocks that become
-/// the optimized course's approach and retract).
-fn extra(b: &SpanMotion, front: (usize, bool), back: (usize, bool)) -> (usize, usize) {
-    let f = if front.1 { b.lead.saturating_sub(front.0) } else { 0 };
-    let k = if back.1 { b.trail.saturating_sub(back.0) } else { 0 };
-    (f, k)
-}
-
-fn same_value(machine: &Machine, i: usize, a: f64, b: f64, turn: f64, tol: f64) -> bool {
-    let d = b - a - turn;
-    if machine.axes[i].kind.wraps() || turn != 0.0 {
-        let r = d - 360.0 * (d / 360.0).round();
-        r.abs() <= tol
-    } else {
-        d.abs() <= tol
+/// Checks that optimized course `kc` is original course `oc` laid forward.
+fn is_forward(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Machine, tol: f64) -> Result<(), String> {
+    let a = span_motion(orig, oc);
+    let Some(b) = window(opt, kc, a.lead, a.trail) else {
+        return Err(format!("fewer than {} moves around its laid moves", a.lead + a.trail));
+    };
+    if a.moves.len() != b.moves.len() {
+        return Err(format!("{} moves instead of {}", b.moves.len(), a.moves.len()));
     }
-}
-
-fn same_feed(a: f64, b: f64) -> bool {
-    (a.is_nan() && b.is_nan()) || a == b
-}
-
-/// Checks that `opt`'s course `kc` is `orig`'s course `oc` laid forward.
-fn is_forward(a: &SpanMotion, b: &SpanMotion, machine: &Machine, tol: f64) -> Result<(), String> {
-    let (front, back) = extra(b, (a.lead, a.short_approach), (a.trail, a.short_retract));
-    let (bp, bm) = b.trimmed(front, back);
-    if a.moves.len() != bm.len() {
-        return Err(format!("{} moves instead of {}", bm.len(), a.moves.len()));
-    }
-    for (i, (pa, pb)) in a.points.iter().zip(bp).enumerate() {
+    for (i, (pa, pb)) in a.points.iter().zip(&b.points).enumerate() {
         for ax in 0..machine.dim() {
             if !same_value(machine, ax, pa[ax], pb[ax], 0.0, tol) {
                 return Err(format!("point {i}: axis {} is {} instead of {}", machine.axes[ax].label, pb[ax], pa[ax]));
             }
         }
     }
-    for (i, (ma, mb)) in a.moves.iter().zip(bm).enumerate() {
+    for (i, (ma, mb)) in a.moves.iter().zip(&b.moves).enumerate() {
         if ma.0 != mb.0 || ma.1 != mb.1 || (ma.0 && !same_feed(ma.2, mb.2)) {
             return Err(format!("move {i}: contact, tows or feed differ"));
         }
@@ -357,18 +333,20 @@ fn is_forward(a: &SpanMotion, b: &SpanMotion, machine: &Machine, tol: f64) -> Re
     Ok(())
 }
 
-/// Checks that `opt`'s course `kc` is `orig`'s course `oc` legally reversed.
-fn is_reversal(a: &SpanMotion, b: &SpanMotion, machine: &Machine, tol: f64) -> Result<(), String> {
+/// Checks that optimized course `kc` is original course `oc` legally reversed.
+fn is_reversal(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Machine, tol: f64) -> Result<(), String> {
+    let a = span_motion(orig, oc);
     // Reversed, the original's retract leads and its approach trails.
-    let (front, back) = extra(b, (a.trail, a.short_retract), (a.lead, a.short_approach));
-    let (bp, bm) = b.trimmed(front, back);
+    let Some(b) = window(opt, kc, a.trail, a.lead) else {
+        return Err(format!("fewer than {} moves around its laid moves", a.lead + a.trail));
+    };
     let n = a.moves.len();
-    if n != bm.len() {
-        return Err(format!("{} moves instead of {}", bm.len(), n));
+    if n != b.moves.len() {
+        return Err(format!("{} moves instead of {}", b.moves.len(), n));
     }
     let heading = machine.heading_axis();
     for i in 0..=n {
-        let (pa, pb) = (&a.points[n - i], &bp[i]);
+        let (pa, pb) = (&a.points[n - i], &b.points[i]);
         for ax in 0..machine.dim() {
             let turn = if Some(ax) == heading { 180.0 } else { 0.0 };
             if !same_value(machine, ax, pa[ax], pb[ax], turn, tol) {
@@ -384,7 +362,7 @@ fn is_reversal(a: &SpanMotion, b: &SpanMotion, machine: &Machine, tol: f64) -> R
         }
     }
     for i in 0..n {
-        let (ma, mb) = (&a.moves[n - 1 - i], &bm[i]);
+        let (ma, mb) = (&a.moves[n - 1 - i], &b.moves[i]);
         if ma.0 != mb.0 {
             return Err(format!("reversed move {i}: roller contact differs from the original's move {}", n - 1 - i));
         }
@@ -401,6 +379,20 @@ fn is_reversal(a: &SpanMotion, b: &SpanMotion, machine: &Machine, tol: f64) -> R
         }
     }
     Ok(())
+}
+
+fn same_value(machine: &Machine, i: usize, a: f64, b: f64, turn: f64, tol: f64) -> bool {
+    let d = b - a - turn;
+    if machine.axes[i].kind.wraps() || turn != 0.0 {
+        let r = d - 360.0 * (d / 360.0).round();
+        r.abs() <= tol
+    } else {
+        d.abs() <= tol
+    }
+}
+
+fn same_feed(a: f64, b: f64) -> bool {
+    (a.is_nan() && b.is_nan()) || a == b
 }
 
 fn span_text(p: &Program, c: usize) -> String {
@@ -460,7 +452,6 @@ fn match_courses(
     orig: &Program,
     opt: &Program,
     machine: &Machine,
-    dialect: &Dialect,
     tol: f64,
 ) -> Result<(Vec<Placement>, Vec<bool>), VerifyError> {
     let k = orig.courses.len();
@@ -492,7 +483,6 @@ fn match_courses(
     let mut rewritten = Vec::with_capacity(k);
     for kc in 0..k {
         let text = span_text(opt, kc);
-        let b = span_motion(opt, kc, dialect);
         let mut found = None;
         let mut detail = String::new();
         if let Some(cands) = by_text.get(&text) {
@@ -500,7 +490,7 @@ fn match_courses(
                 if used[oc] {
                     continue;
                 }
-                match is_forward(&span_motion(orig, oc, dialect), &b, machine, tol) {
+                match is_forward(orig, oc, opt, kc, machine, tol) {
                     Ok(()) => {
                         found = Some(Placement { course: oc, reversed: false });
                         break;
@@ -513,7 +503,7 @@ fn match_courses(
         let start = laying_point(opt, kc, false);
         if found.is_none() {
             for oc in near(&by_start, start) {
-                if !used[oc] && is_forward(&span_motion(orig, oc, dialect), &b, machine, tol).is_ok() {
+                if !used[oc] && is_forward(orig, oc, opt, kc, machine, tol).is_ok() {
                     found = Some(Placement { course: oc, reversed: false });
                     break;
                 }
@@ -529,7 +519,7 @@ fn match_courses(
                     if used[oc] {
                         continue;
                     }
-                    match is_reversal(&span_motion(orig, oc, dialect), &b, machine, tol) {
+                    match is_reversal(orig, oc, opt, kc, machine, tol) {
                         Ok(()) => {
                             found = Some(Placement { course: oc, reversed: true });
                             break;

@@ -531,6 +531,26 @@ fn courses_with_short_approach_or_retract_blocks_verify_when_moved() {
         assert_ne!(bad, out);
         assert!(verify(&text, &bad, &m, &d, &vopts()).is_err());
     }
+    // Courses that all end where the next one's approach starts: moved, a course with no
+    // retract is followed by no transit at all, and the next course's approach reads as its
+    // retract. The approach is still checked, wherever it was read.
+    let mut ends = String::from("G90\n(PLY 1)\n");
+    for (n, y) in [(1, 0.0), (2, 40.0), (3, 80.0)] {
+        ends.push_str(&format!("(COURSE {n})\nG0 X0 Y{y} Z20\nM20\nM60 P1\nG1 X300 Y0 F3000\nM61 P1\nM21\n"));
+        if n < 3 {
+            ends.push_str("G1 Z20\n");
+        }
+    }
+    ends.push_str("M30\n");
+    let p = parse(&ends, &m, &d).unwrap();
+    assert!(p.courses[2].retract().is_empty());
+    let order: Vec<Placement> = (0..3).rev().map(|course| Placement { course, reversed: false }).collect();
+    let out = rewrite(&p, &order, &m, &d, &[]).unwrap();
+    let v = verify(&ends, &out, &m, &d, &vopts()).unwrap();
+    assert_eq!(v.order, order);
+    let moved = out.replacen("G0 X0 Y40 Z20", "G0 X0 Y41 Z20", 1);
+    assert_ne!(moved, out);
+    assert!(verify(&ends, &moved, &m, &d, &vopts()).is_err(), "a changed approach is caught");
     // The optimizer's self-check accepts its own output too, in either dialect reading.
     for dialect in [d.clone(), Dialect { retract_moves: 0, ..Dialect::default() }] {
         for bi in [false, true] {
