@@ -258,8 +258,9 @@ struct SpanMotion {
     trail: usize,
 }
 
-/// The moves `segs` of `p`, starting from `start` if there are none.
-fn motion_of(p: &Program, segs: std::ops::Range<usize>, start: &[f64]) -> SpanMotion {
+/// The moves `segs` of `p` (starting from `start` if there are none), `lead` of them before
+/// the laying and `trail` after.
+fn motion_of(p: &Program, segs: std::ops::Range<usize>, start: &[f64], lead: usize, trail: usize) -> SpanMotion {
     let first = p.segments.get(segs.start).filter(|_| !segs.is_empty());
     let mut points = vec![first.map_or_else(|| start.to_vec(), |s| p.point(s.from).to_vec())];
     let mut moves = Vec::with_capacity(segs.len());
@@ -267,46 +268,60 @@ fn motion_of(p: &Program, segs: std::ops::Range<usize>, start: &[f64]) -> SpanMo
         points.push(p.point(s.to).to_vec());
         moves.push((s.on_part, s.mask, s.feed));
     }
-    let lead = moves.iter().position(|m| m.0).unwrap_or(moves.len());
-    let trail = moves.iter().rposition(|m| m.0).map_or(0, |l| moves.len() - 1 - l);
     SpanMotion { points, moves, lead, trail }
+}
+
+/// The moves of course `c` that lay material, as a range of `p.segments`: from its first laid
+/// move to its last; for a course that lays nothing, the moves on the lines of its on-part
+/// block (often none: then an empty range where that block sits).
+fn laying(p: &Program, c: usize) -> std::ops::Range<usize> {
+    let course = &p.courses[c];
+    let segs = course.segments.clone();
+    let first = segs.clone().find(|&i| p.segments[i].on_part);
+    let last = segs.clone().rev().find(|&i| p.segments[i].on_part);
+    if let (Some(f), Some(l)) = (first, last) {
+        return f..l + 1;
+    }
+    let lo = segs.clone().find(|&i| p.segments[i].line as usize >= course.on_part.start).unwrap_or(segs.end);
+    let hi = (lo..segs.end).find(|&i| p.segments[i].line as usize >= course.on_part.end).unwrap_or(segs.end);
+    lo..hi
 }
 
 /// The moves of course `c`'s span.
 fn span_motion(p: &Program, c: usize) -> SpanMotion {
     let course = &p.courses[c];
-    motion_of(p, course.segments.clone(), &course.span_start.phys)
+    let (segs, laid) = (course.segments.clone(), laying(p, c));
+    motion_of(p, segs.clone(), &course.span_start.phys, laid.start - segs.start, segs.end - laid.end)
 }
 
-/// The moves of optimized course `kc` to compare with an original course: its laid moves with
-/// the `lead` moves before them and the `trail` moves after, wherever reading the optimized
-/// program put those. (Where an original approach or retract block is short, because nothing
-/// moved before the course or one move joined two courses, the regenerated transit, or the
-/// next course's approach, reads as part of it; such moves are off-part all the same.) `None`
-/// if the program has not that many moves there. A course that lays no move is its span.
+/// The moves of optimized course `kc` to compare with an original course: its laying (see
+/// [`laying`]) with the `lead` moves before it and the `trail` moves after, wherever reading
+/// the optimized program put those. (Where an original approach or retract block is short,
+/// because nothing moved before the course or one move joined two courses, the regenerated
+/// transit, or the next course's approach, reads as part of it; such moves are off-part all the
+/// same.) `None` if the program has not that many moves there.
 fn window(p: &Program, kc: usize, lead: usize, trail: usize) -> Option<SpanMotion> {
-    let segs = p.courses[kc].segments.clone();
-    let first = segs.clone().find(|&i| p.segments[i].on_part);
-    let last = segs.clone().rev().find(|&i| p.segments[i].on_part);
-    let (Some(f), Some(l)) = (first, last) else {
-        return Some(span_motion(p, kc));
-    };
-    let (lo, hi) = (f.checked_sub(lead)?, l + 1 + trail);
+    let laid = laying(p, kc);
+    let (lo, hi) = (laid.start.checked_sub(lead)?, laid.end + trail);
     if hi > p.segments.len() {
         return None;
     }
-    Some(motion_of(p, lo..hi, &p.courses[kc].span_start.phys))
+    Some(motion_of(p, lo..hi, &p.courses[kc].span_start.phys, lead, trail))
 }
 
-/// The point where a course starts laying (forward) or ends laying, for finding candidates.
+/// The point where a course starts laying (forward) or ends laying, for finding candidates
+/// (for a course that lays nothing, where its on-part block sits).
 fn laying_point(p: &Program, c: usize, end: bool) -> &[f64] {
-    let mut laid = p.on_part_segments(c);
-    let found = if end { laid.last().map(|s| s.to) } else { laid.next().map(|s| s.from) };
-    match found {
-        Some(i) => p.point(i),
-        None if end => &p.courses[c].exit.phys,
-        None => &p.courses[c].span_start.phys,
-    }
+    let laid = laying(p, c);
+    let before = |i: usize| match p.segments.get(i) {
+        Some(s) => s.from,
+        None => (p.points.len() / p.dim.max(1)).saturating_sub(1) as u32,
+    };
+    let at = match (laid.is_empty(), end) {
+        (false, true) => p.segments[laid.end - 1].to,
+        _ => before(laid.start),
+    };
+    p.point(at)
 }
 
 /// Checks that optimized course `kc` is original course `oc` laid forward.

@@ -591,3 +591,25 @@ fn comments_on_transit_lines_verify_in_the_original_order() {
     let lost = o.text.replacen(" (first)", "", 1);
     assert!(matches!(verify(&single, &lost, &m, &d, &vopts()).unwrap_err(), VerifyError::LostLine { .. }));
 }
+
+/// A course that lays nothing (roller on and off, tows restarted and cut, at one point) with
+/// no retract: reversed, its approach becomes its retract and the transit its approach; the
+/// verifier anchors the comparison where its on-part block sits. Found by the fuzz target.
+#[test]
+fn a_course_that_lays_nothing_reverses_and_verifies() {
+    let d = Dialect::default();
+    let m = gantry();
+    let text = format!(
+        "G90\n(PLY 1)\n{}(COURSE 2)\nG0 X500 Y0 Z20 C0\nG1 Z0 F1000\nM20\nM60 P1\nM61 P1\nM21\nM30\n",
+        course(1, 0.0, 0.0, 400.0)
+    );
+    let p = parse(&text, &m, &d).unwrap();
+    assert_eq!(p.on_part_segments(1).count(), 0);
+    let rev: Vec<_> = (0..2).map(|c| towpath_nc::reverse_course(&p, c, &m, &d).ok()).collect();
+    for order in [[(1, true), (0, true)], [(1, true), (0, false)], [(0, true), (1, true)]] {
+        let order: Vec<Placement> = order.iter().map(|&(course, reversed)| Placement { course, reversed }).collect();
+        let out = rewrite(&p, &order, &m, &d, &rev).unwrap();
+        let v = verify(&text, &out, &m, &d, &vopts()).unwrap_or_else(|e| panic!("{order:?}: {e}\n{out}"));
+        assert_eq!(v.order, order);
+    }
+}
