@@ -244,7 +244,7 @@ pub fn verify_parsed(
     })
 }
 
-/// One move: (on-part, tows on, feed).
+/// One move: (on-part, tows on, feed; NaN for a rapid move).
 type SpanMove = (bool, u64, f64);
 
 /// Consecutive moves of a program as points (physical values), with each move's (on-part,
@@ -266,7 +266,8 @@ fn motion_of(p: &Program, segs: std::ops::Range<usize>, start: &[f64], lead: usi
     let mut moves = Vec::with_capacity(segs.len());
     for s in &p.segments[segs] {
         points.push(p.point(s.to).to_vec());
-        moves.push((s.on_part, s.mask, s.feed));
+        // A rapid move has no feed: it moves at the machine's speed, whatever the modal feed.
+        moves.push((s.on_part, s.mask, if s.rapid { f64::NAN } else { s.feed }));
     }
     SpanMotion { points, moves, lead, trail }
 }

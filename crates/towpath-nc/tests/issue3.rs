@@ -613,3 +613,25 @@ fn a_course_that_lays_nothing_reverses_and_verifies() {
         assert_eq!(v.order, order);
     }
 }
+
+/// A rapid move on-part moves at the machine's speed whatever the modal feed, so reversed
+/// after a feed change it is still the same move; turning it into a feed move is not. Found by
+/// the fuzz target.
+#[test]
+fn rapid_moves_on_part_have_no_feed_to_compare() {
+    let d = Dialect::default();
+    let m = gantry();
+    let odd = "(COURSE 2)\nG0 X0 Y100 Z20 C0\nG1 Z0 F1000\nM20\nM60 P1\nG0 X50\nF91\nG1 X100\nM61 P1\nM21\nG1 Z20\n";
+    let text = format!("G90\n(PLY 1)\n{}{odd}M30\n", course(1, 0.0, 0.0, 400.0));
+    let p = parse(&text, &m, &d).unwrap();
+    let rev: Vec<_> = (0..2).map(|c| towpath_nc::reverse_course(&p, c, &m, &d).ok()).collect();
+    let order = vec![Placement { course: 1, reversed: true }, Placement { course: 0, reversed: false }];
+    let out = rewrite(&p, &order, &m, &d, &rev).unwrap();
+    verify(&text, &out, &m, &d, &vopts()).unwrap();
+    let order = vec![Placement { course: 1, reversed: false }, Placement { course: 0, reversed: false }];
+    let out = rewrite(&p, &order, &m, &d, &rev).unwrap();
+    verify(&text, &out, &m, &d, &vopts()).unwrap();
+    let fed = out.replacen("G0 X50\n", "G1 X50\n", 1);
+    assert_ne!(fed, out);
+    assert!(matches!(verify(&text, &fed, &m, &d, &vopts()).unwrap_err(), VerifyError::Unmatched { .. }));
+}
