@@ -258,11 +258,18 @@ struct SpanMotion {
     trail: usize,
 }
 
-/// The moves `segs` of `p` (starting from `start` if there are none), `lead` of them before
-/// the laying and `trail` after.
-fn motion_of(p: &Program, segs: std::ops::Range<usize>, start: &[f64], lead: usize, trail: usize) -> SpanMotion {
-    let first = p.segments.get(segs.start).filter(|_| !segs.is_empty());
-    let mut points = vec![first.map_or_else(|| start.to_vec(), |s| p.point(s.from).to_vec())];
+/// The position of program `p` just before its move `i` (after its last move if `i` is past
+/// the end), as a point index.
+fn point_before(p: &Program, i: usize) -> u32 {
+    match p.segments.get(i) {
+        Some(s) => s.from,
+        None => (p.points.len() / p.dim.max(1)).saturating_sub(1) as u32,
+    }
+}
+
+/// The moves `segs` of `p`, `lead` of them before the laying and `trail` after.
+fn motion_of(p: &Program, segs: std::ops::Range<usize>, lead: usize, trail: usize) -> SpanMotion {
+    let mut points = vec![p.point(point_before(p, segs.start)).to_vec()];
     let mut moves = Vec::with_capacity(segs.len());
     for s in &p.segments[segs] {
         points.push(p.point(s.to).to_vec());
@@ -292,7 +299,7 @@ fn laying(p: &Program, c: usize) -> std::ops::Range<usize> {
 fn span_motion(p: &Program, c: usize) -> SpanMotion {
     let course = &p.courses[c];
     let (segs, laid) = (course.segments.clone(), laying(p, c));
-    motion_of(p, segs.clone(), &course.span_start.phys, laid.start - segs.start, segs.end - laid.end)
+    motion_of(p, segs.clone(), laid.start - segs.start, segs.end - laid.end)
 }
 
 /// The moves of optimized course `kc` to compare with an original course: its laying (see
@@ -307,20 +314,16 @@ fn window(p: &Program, kc: usize, lead: usize, trail: usize) -> Option<SpanMotio
     if hi > p.segments.len() {
         return None;
     }
-    Some(motion_of(p, lo..hi, &p.courses[kc].span_start.phys, lead, trail))
+    Some(motion_of(p, lo..hi, lead, trail))
 }
 
 /// The point where a course starts laying (forward) or ends laying, for finding candidates
 /// (for a course that lays nothing, where its on-part block sits).
 fn laying_point(p: &Program, c: usize, end: bool) -> &[f64] {
     let laid = laying(p, c);
-    let before = |i: usize| match p.segments.get(i) {
-        Some(s) => s.from,
-        None => (p.points.len() / p.dim.max(1)).saturating_sub(1) as u32,
-    };
     let at = match (laid.is_empty(), end) {
         (false, true) => p.segments[laid.end - 1].to,
-        _ => before(laid.start),
+        _ => point_before(p, laid.start),
     };
     p.point(at)
 }

@@ -612,6 +612,20 @@ fn a_course_that_lays_nothing_reverses_and_verifies() {
         let v = verify(&text, &out, &m, &d, &vopts()).unwrap_or_else(|e| panic!("{order:?}: {e}\n{out}"));
         assert_eq!(v.order, order);
     }
+    // A third course with no move at all, right after the second: moved first and reversed,
+    // the transit to it reads as its approach; its place is where its on-part block sits.
+    let text = text.replacen("M30\n", "(COURSE 3)\nM20\nM21\nM30\n", 1);
+    let p = parse(&text, &m, &d).unwrap();
+    assert_eq!(p.courses.len(), 3);
+    let rev: Vec<_> = (0..3).map(|c| towpath_nc::reverse_course(&p, c, &m, &d).ok()).collect();
+    for order in [[(2, true), (1, true), (0, true)], [(2, false), (0, false), (1, false)]] {
+        let order: Vec<Placement> = order.iter().map(|&(course, reversed)| Placement { course, reversed }).collect();
+        let out = rewrite(&p, &order, &m, &d, &rev).unwrap();
+        let v = verify(&text, &out, &m, &d, &vopts()).unwrap_or_else(|e| panic!("{order:?}: {e}\n{out}"));
+        // Two courses that lay nothing at the same point are interchangeable: only the course
+        // that lays material must be where it was put.
+        assert_eq!(v.order.iter().position(|p| p.course == 0), order.iter().position(|p| p.course == 0));
+    }
 }
 
 /// A rapid move on-part moves at the machine's speed whatever the modal feed, so reversed
