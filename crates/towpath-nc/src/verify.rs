@@ -488,13 +488,19 @@ fn match_courses(
         let key: Vec<i64> = point_cell(machine, laying_point(orig, c, false)).iter().map(|x| x.0).collect();
         by_start.entry(key).or_default().push(c);
     }
+    // Moves each original course has around its laying (approach and retract).
+    let around: Vec<usize> = (0..k).map(|c| orig.courses[c].segments.len() - laying(orig, c).len()).collect();
+    // Candidates near a point, those with the most moves around their laying first: of two
+    // courses that lay the same, the one that also needs a retract (say) must take the
+    // optimized course that has it, leaving the other for one that may not.
     let near = |map: &HashMap<Vec<i64>, Vec<usize>>, p: &[f64]| -> Vec<usize> {
         let mut v: Vec<usize> = neighbour_cells(&point_cell(machine, p))
             .iter()
             .filter_map(|key| map.get(key))
             .flat_map(|v| v.iter().copied())
             .collect();
-        v.sort_unstable();
+        v.sort_unstable_by_key(|&c| (std::cmp::Reverse(around[c]), c));
+        v.dedup();
         v
     };
     let mut used = vec![false; k];

@@ -649,3 +649,29 @@ fn rapid_moves_on_part_have_no_feed_to_compare() {
     assert_ne!(fed, out);
     assert!(matches!(verify(&text, &fed, &m, &d, &vopts()).unwrap_err(), VerifyError::Unmatched { .. }));
 }
+
+/// Two courses that lay exactly the same, one with a retract move and one without: the
+/// verifier must give the optimized course that has the retract to the original that needs
+/// one. Found by the fuzz target.
+#[test]
+fn twin_courses_are_told_apart_by_their_retract() {
+    let d = Dialect::default();
+    let m = gantry();
+    let lay = |n: usize, y: f64| format!("(COURSE {n})\nM20\nM60 P1\nG1 X100 Y{y} F3000\nG1 X0\nM61 P1\nM21\n");
+    // A: laid from home with no approach, no retract. B: the same laying, then a
+    // (zero-length) retract. C: elsewhere.
+    let text = format!(
+        "G90\n(PLY 1)\n{}{}G1 Z0\n(COURSE 3)\nG0 X0 Y50 Z0\n{}G1 Z0\nM30\n",
+        lay(1, 0.0),
+        lay(2, 0.0),
+        lay(3, 50.0).replacen("(COURSE 3)\n", "", 1)
+    );
+    let p = parse(&text, &m, &d).unwrap();
+    assert_eq!(p.courses.len(), 3);
+    assert!(p.courses[0].approach().is_empty() && p.courses[0].retract().is_empty());
+    assert!(p.courses[1].approach().is_empty() && !p.courses[1].retract().is_empty());
+    let order: Vec<Placement> = [2, 1, 0].iter().map(|&course| Placement { course, reversed: false }).collect();
+    let out = rewrite(&p, &order, &m, &d, &[]).unwrap();
+    let v = verify(&text, &out, &m, &d, &vopts()).unwrap_or_else(|e| panic!("{e}\n{out}"));
+    assert_eq!(v.order, order);
+}
