@@ -280,8 +280,8 @@ fn motion_of(p: &Program, segs: std::ops::Range<usize>, lead: usize, trail: usiz
 }
 
 /// The moves of course `c` that lay material, as a range of `p.segments`: from its first laid
-/// move to its last; for a course that lays nothing, the moves on the lines of its on-part
-/// block (often none: then an empty range where that block sits).
+/// move to its last; for a course that lays nothing, an empty range where the roller comes
+/// into contact.
 fn laying(p: &Program, c: usize) -> std::ops::Range<usize> {
     let course = &p.courses[c];
     let segs = course.segments.clone();
@@ -290,9 +290,11 @@ fn laying(p: &Program, c: usize) -> std::ops::Range<usize> {
     if let (Some(f), Some(l)) = (first, last) {
         return f..l + 1;
     }
-    let lo = segs.clone().find(|&i| p.segments[i].line as usize >= course.on_part.start).unwrap_or(segs.end);
-    let hi = (lo..segs.end).find(|&i| p.segments[i].line as usize >= course.on_part.end).unwrap_or(segs.end);
-    lo..hi
+    // Nothing laid: the place where the roller comes into contact (after a move written on that
+    // line, which comes before the contact when it is not laid). Reversed, the contact comes
+    // where the original lifted, so the moves on either side swap as the blocks do.
+    let at = segs.clone().find(|&i| p.segments[i].line as usize > course.on_part.start).unwrap_or(segs.end);
+    at..at
 }
 
 /// The moves of course `c`'s span.

@@ -612,6 +612,18 @@ fn a_course_that_lays_nothing_reverses_and_verifies() {
         let v = verify(&text, &out, &m, &d, &vopts()).unwrap_or_else(|e| panic!("{order:?}: {e}\n{out}"));
         assert_eq!(v.order, order);
     }
+    // The same with the plunge written on the contact line (the move comes first, so it is
+    // not laid): reversed, the move comes after the lift.
+    let plunge = text.replacen("G1 Z0 F1000\nM20\nM60 P1\nM61 P1", "G1 Z0 F1000 M20\nM60 P1\nM61 P1", 1);
+    assert_ne!(plunge, text);
+    let p2 = parse(&plunge, &m, &d).unwrap();
+    let rev2: Vec<_> = (0..2).map(|c| towpath_nc::reverse_course(&p2, c, &m, &d).ok()).collect();
+    for order in [[(1, true), (0, false)], [(0, false), (1, true)]] {
+        let order: Vec<Placement> = order.iter().map(|&(course, reversed)| Placement { course, reversed }).collect();
+        let out = rewrite(&p2, &order, &m, &d, &rev2).unwrap();
+        let v = verify(&plunge, &out, &m, &d, &vopts()).unwrap_or_else(|e| panic!("{order:?}: {e}\n{out}"));
+        assert_eq!(v.order, order);
+    }
     // A third course with no move at all, right after the second: moved first and reversed,
     // the transit to it reads as its approach; its place is where its on-part block sits.
     let text = text.replacen("M30\n", "(COURSE 3)\nM20\nM21\nM30\n", 1);
