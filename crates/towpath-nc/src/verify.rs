@@ -505,70 +505,135 @@ fn match_courses(
         v.dedup();
         v
     };
-    let mut used = vec![false; k];
-    let mut order = Vec::with_capacity(k);
-    let mut rewritten = Vec::with_capacity(k);
-    for kc in 0..k {
-        let text = span_text(opt, kc);
-        let mut found = None;
+    // Every original course that optimized course `kc` may be, in order of preference: same
+    // lines, then same motion forward, then a legal reversal. With `unused`, stops at the first
+    // candidate not yet taken. Each comes with "same lines" and, if there is none, why.
+    let candidates = |kc: usize, unused: Option<&[bool]>| -> (Vec<(Placement, bool)>, String) {
+        let mut out: Vec<(Placement, bool)> = Vec::new();
         let mut detail = String::new();
+        let take = |oc: usize| unused.is_none_or(|u| u[oc]);
+        let done = |out: &Vec<(Placement, bool)>| unused.is_some() && !out.is_empty();
+        let text = span_text(opt, kc);
         if let Some(cands) = by_text.get(&text) {
             for &oc in cands.iter().rev() {
-                if used[oc] {
+                if !take(oc) {
                     continue;
                 }
                 match is_forward(orig, oc, opt, kc, machine, tol) {
                     Ok(()) => {
-                        found = Some(Placement { course: oc, reversed: false });
-                        break;
+                        out.push((Placement { course: oc, reversed: false }, true));
+                        if done(&out) {
+                            return (out, detail);
+                        }
                     }
                     Err(e) => detail = format!(": same lines as {} but {e}", orig.course_name(oc)),
                 }
             }
         }
-        let by_text = found.is_some();
         let start = laying_point(opt, kc, false);
-        if found.is_none() {
-            for oc in near(&by_start, start) {
-                if !used[oc] && is_forward(orig, oc, opt, kc, machine, tol).is_ok() {
-                    found = Some(Placement { course: oc, reversed: false });
-                    break;
-                }
-            }
-        }
-        if found.is_none() {
-            let cands = near(&by_end, start);
-            if cands.is_empty() && detail.is_empty() {
-                detail = ": no course of the original stops laying where it starts".into();
-            }
+        for oc in near(&by_start, start) {
+            if take(oc) && !out.iter().any(|x| x.0.course == oc) && is_forward(orig, oc, opt, kc, machine, tol).is_ok()
             {
-                for &oc in cands.iter() {
-                    if used[oc] {
-                        continue;
-                    }
-                    match is_reversal(orig, oc, opt, kc, machine, tol) {
-                        Ok(()) => {
-                            found = Some(Placement { course: oc, reversed: true });
-                            break;
-                        }
-                        Err(e) => detail = format!(": not a legal reversal of {}: {e}", orig.course_name(oc)),
-                    }
+                out.push((Placement { course: oc, reversed: false }, false));
+                if done(&out) {
+                    return (out, detail);
                 }
             }
         }
-        match found {
-            Some(p) => {
-                used[p.course] = true;
-                rewritten.push(!by_text);
-                order.push(p);
+        let cands = near(&by_end, start);
+        if cands.is_empty() && detail.is_empty() && out.is_empty() {
+            detail = ": no course of the original stops laying where it starts".into();
+        }
+        for oc in cands {
+            if !take(oc) || out.iter().any(|x| x.0.course == oc) {
+                continue;
             }
-            None => return Err(VerifyError::Unmatched { line: opt.courses[kc].on_part.start + 1, detail }),
+            match is_reversal(orig, oc, opt, kc, machine, tol) {
+                Ok(()) => {
+                    out.push((Placement { course: oc, reversed: true }, false));
+                    if done(&out) {
+                        return (out, detail);
+                    }
+                }
+                Err(e) => detail = format!(": not a legal reversal of {}: {e}", orig.course_name(oc)),
+            }
+        }
+        (out, detail)
+    };
+    // Greedy in program order; where a course finds every candidate taken (courses alike but
+    // for their approach or retract), an augmenting path re-assigns earlier ones.
+    let mut unused = vec![true; k];
+    let mut owner: Vec<Option<usize>> = vec![None; k];
+    let mut chosen: Vec<Option<(Placement, bool)>> = vec![None; k];
+    let mut all: HashMap<usize, Vec<(Placement, bool)>> = HashMap::new();
+    for kc in 0..k {
+        let (first, detail) = candidates(kc, Some(&unused));
+        if let Some(&(p, text)) = first.first() {
+            unused[p.course] = false;
+            owner[p.course] = Some(kc);
+            chosen[kc] = Some((p, text));
+            continue;
+        }
+        let (list, _) = candidates(kc, None);
+        if list.is_empty() {
+            return Err(VerifyError::Unmatched { line: opt.courses[kc].on_part.start + 1, detail });
+        }
+        all.insert(kc, list);
+        let mut seen = vec![false; k];
+        if !augment(kc, &mut seen, &mut owner, &mut chosen, &mut all, &candidates) {
+            return Err(VerifyError::Unmatched {
+                line: opt.courses[kc].on_part.start + 1,
+                detail: ": every course of the original it could be is laid elsewhere".into(),
+            });
+        }
+        for (u, o) in unused.iter_mut().zip(&owner) {
+            *u = o.is_none();
         }
     }
-    if let Some(c) = used.iter().position(|u| !u) {
+    let mut order = Vec::with_capacity(k);
+    let mut rewritten = Vec::with_capacity(k);
+    for c in chosen {
+        let Some((p, text)) = c else {
+            return Err(VerifyError::Missing(String::from("a course")));
+        };
+        order.push(p);
+        rewritten.push(!text);
+    }
+    if let Some(c) = owner.iter().position(Option::is_none) {
         return Err(VerifyError::Missing(orig.course_name(c)));
     }
     Ok((order, rewritten))
+}
+
+/// Kuhn's augmenting path: gives optimized course `kc` one of its candidates, moving the
+/// courses that hold them to other candidates of theirs if need be.
+fn augment<F>(
+    kc: usize,
+    seen: &mut [bool],
+    owner: &mut [Option<usize>],
+    chosen: &mut [Option<(Placement, bool)>],
+    all: &mut HashMap<usize, Vec<(Placement, bool)>>,
+    candidates: &F,
+) -> bool
+where
+    F: Fn(usize, Option<&[bool]>) -> (Vec<(Placement, bool)>, String),
+{
+    let list = all.entry(kc).or_insert_with(|| candidates(kc, None).0).clone();
+    for (p, text) in list {
+        if std::mem::replace(&mut seen[p.course], true) {
+            continue;
+        }
+        let free = match owner[p.course] {
+            None => true,
+            Some(other) => augment(other, seen, owner, chosen, all, candidates),
+        };
+        if free {
+            owner[p.course] = Some(kc);
+            chosen[kc] = Some((p, text));
+            return true;
+        }
+    }
+    false
 }
 
 /// A line that must survive: not a move, and no tow, contact or mode codes (those are checked
