@@ -276,7 +276,8 @@ fn swapped_event(e: &Event, dialect: &Dialect, lexed: &Lexed) -> String {
     }
 }
 
-/// An event line with its code word swapped (restart ↔ cut, contact on ↔ off), the rest kept.
+/// An event line with its code word swapped (restart ↔ cut, contact on ↔ off; every copy of
+/// it), the rest kept.
 fn swap_line_code(line: &str, e: &Event, dialect: &Dialect, codes: &crate::dialect::Codes, lexed: &Lexed) -> String {
     let (from, to) = match *e {
         Event::Contact(on) => match &codes.contact {
@@ -297,10 +298,17 @@ fn swap_line_code(line: &str, e: &Event, dialect: &Dialect, codes: &crate::diale
             }
         }
     };
-    match lexed.words.iter().find(|w| from.matches(w.letter, w.value)) {
-        Some(w) => format!("{}{}{}", &line[..w.span.start], to, &line[w.span.end..]),
-        None => swapped_event(e, dialect, lexed),
+    // Every word of that code (a line may repeat it), from the end so the spans stay right.
+    let spans: Vec<_> =
+        lexed.words.iter().filter(|w| from.matches(w.letter, w.value)).map(|w| w.span.clone()).collect();
+    if spans.is_empty() {
+        return swapped_event(e, dialect, lexed);
     }
+    let mut out = line.to_string();
+    for span in spans.into_iter().rev() {
+        out.replace_range(span, &to);
+    }
+    out
 }
 
 /// Formats a number with at most `decimals` digits after the point, trailing zeros dropped.

@@ -692,7 +692,8 @@ fn twin_courses_are_told_apart_by_their_retract() {
 /// written in reverse order, reversing what can be, verifies against the input; only
 /// precedence may be left unchecked (there is no width). `look-alike-courses.nc` has several
 /// courses that lay nothing at the same point with different approach and retract moves: the
-/// verifier's greedy matching needs an augmenting path there.
+/// verifier's greedy matching needs an augmenting path there; `repeated-contact-code.nc` has
+/// a lift written twice on one line, which the reversal must swap twice.
 #[test]
 fn fuzz_regressions_verify() {
     let mut c = Axis::new("C", AxisKind::Continuous);
