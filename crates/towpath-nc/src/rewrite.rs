@@ -122,9 +122,19 @@ pub fn rewrite(
         } else {
             None
         };
-        let target = rev.map_or(&course.insert, |r| &r.entry);
-        e.transit(target)?;
-        e.items(program, &course.pre_after)?;
+        match rev {
+            None => {
+                // The lines after the original transit run after the new one, as they did.
+                e.transit(&course.insert)?;
+                e.items(program, &course.pre_after)?;
+            }
+            Some(r) => {
+                // The reversed span needs exactly its entry state: the lines that followed the
+                // original transit (which may set positions or modes) go before the new one.
+                e.items(program, &course.pre_after)?;
+                e.transit(&r.entry)?;
+            }
+        }
         match rev {
             Some(r) => {
                 for l in &r.lines {

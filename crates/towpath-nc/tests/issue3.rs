@@ -730,3 +730,27 @@ fn fuzz_regressions_verify() {
     }
     assert!(n >= 1);
 }
+
+/// A set-position line after a course's transit (`G92 Z30`: the course is written in shifted
+/// coordinates): laid reversed, that line runs before the new transit, which then reaches the
+/// reversed course's entry in those coordinates. (Run after the new transit, as it was after
+/// the old one, it declared the offset at the wrong place.) Found by the fuzz target.
+#[test]
+fn set_position_lines_before_a_reversed_course() {
+    let d = Dialect::default();
+    let m = gantry();
+    let text = program().replacen("G0 X0 Y80 Z20 C0\n", "G0 X0 Y80 Z20 C0\nG92 Z30\n", 1);
+    assert_ne!(text, program());
+    let p = parse(&text, &m, &d).unwrap();
+    assert!((p.courses[1].span_start.phys[2] - p.courses[1].span_start.prog[2] + 10.0).abs() < 1e-12);
+    let rev: Vec<_> = (0..p.courses.len()).map(|c| towpath_nc::reverse_course(&p, c, &m, &d).ok()).collect();
+    let order: Vec<Placement> = [(0, false), (1, true), (2, false), (3, false), (4, true)]
+        .iter()
+        .map(|&(course, reversed)| Placement { course, reversed })
+        .collect();
+    let out = rewrite(&p, &order, &m, &d, &rev).unwrap();
+    let v = verify(&text, &out, &m, &d, &vopts()).unwrap_or_else(|e| panic!("{e}\n{out}"));
+    assert_eq!(v.order, order);
+    let o = optimize(&text, &m, &d, &opts(true)).unwrap();
+    verify(&text, &o.text, &m, &d, &vopts()).unwrap();
+}
