@@ -253,9 +253,9 @@ def main():
         lines.append(f"| {r['angle']:+.0f}° | {r['courses']} | {r['mean_angle_deviation_deg']:.5f} | {r['max_angle_deviation_deg']:.5f} | "
                      f"{r['coverage_percent']:.2f} | {r['seconds']:.3f} |")
     lines.append("")
-    lines.append("Coverage is below 100 % because 13 courses of 101.6 mm leave a 12 mm strip on the closed tube "
-                 "(1885 mm × cos 45° = 1333 mm ≠ 13 × 101.6 mm); a 14th course would overlap by 90 mm. The strip is "
-                 "reported as the widest gap.")
+    lines.append("13 whole courses of 101.6 mm leave a 12 mm strip on the closed tube (1885 mm × cos 45° = 1333 mm "
+                 "≠ 13 × 101.6 mm); the 14th course is the closing course, which lays only the tows its coverage "
+                 "rule gives to the strip (two at 50 %) and cuts the others where they would lie on laid courses.")
     lines.append("")
 
     # 3. Full ply timing.

@@ -4,7 +4,9 @@
 //! mesh, and oriented counter-clockwise about the outward normal (interior on the left). Membership
 //! of a surface point is the sign of its distance to the nearest boundary segment, taken in the
 //! tangent plane, with the bisector rule at polyline vertices (exact for plane polygons; on curved
-//! surfaces it relies on the boundary being closer along the surface than across it).
+//! surfaces it relies on the boundary being closer along the surface than across it). Only segments
+//! whose surface normal faces the same way as the point's count, so a boundary on one skin of a
+//! thin part does not take in the other skin.
 //! The mesh's own boundary loops are indexed the same way, for fast "far from any edge" tests.
 
 use glam::DVec3;
@@ -27,6 +29,8 @@ struct Seg {
     /// Outward normals of the segments before and after (for the vertex bisector rule).
     out_prev: DVec3,
     out_next: DVec3,
+    /// The surface normal along the segment.
+    normal: DVec3,
 }
 
 impl RTreeObject for Seg {
@@ -65,9 +69,16 @@ impl Loops {
                 })
                 .collect();
             for i in 0..n {
-                let a = lp[i].0;
-                let b = lp[(i + 1) % n].0;
-                segs.push(Seg { a, b, out: outs[i], out_prev: outs[(i + n - 1) % n], out_next: outs[(i + 1) % n] });
+                let (a, na) = lp[i];
+                let (b, nb) = lp[(i + 1) % n];
+                segs.push(Seg {
+                    a,
+                    b,
+                    out: outs[i],
+                    out_prev: outs[(i + n - 1) % n],
+                    out_next: outs[(i + 1) % n],
+                    normal: (na + nb).normalize_or_zero(),
+                });
             }
         }
         Loops { tree: RTree::bulk_load(segs) }
@@ -82,6 +93,28 @@ impl Loops {
     /// +∞ when there are no loops.
     pub fn signed_distance(&self, q: DVec3) -> f64 {
         let Some(s) = self.tree.nearest_neighbor(&q.to_array()) else { return f64::INFINITY };
+        Self::side_of(s, q)
+    }
+
+    /// Signed distance of a surface point `q` with unit normal `n` to the nearest segment on the
+    /// same side of the part (segment normal within 90° of `n`), among the 32 nearest: on a thin
+    /// part, a loop drawn on one skin is near the other skin in space but not along the surface.
+    /// A point with no such segment near is outside, at the distance of the nearest segment;
+    /// +∞ when there are no loops.
+    pub fn signed_distance_facing(&self, q: DVec3, n: DVec3) -> f64 {
+        let mut nearest: Option<f64> = None;
+        for s in self.tree.nearest_neighbor_iter(&q.to_array()).take(32) {
+            if s.normal.dot(n) > 0.0 || s.normal == DVec3::ZERO || n == DVec3::ZERO {
+                return Self::side_of(s, q);
+            }
+            if nearest.is_none() {
+                nearest = Some(s.distance_2(&q.to_array()).sqrt());
+            }
+        }
+        nearest.map_or(f64::INFINITY, |d| -d)
+    }
+
+    fn side_of(s: &Seg, q: DVec3) -> f64 {
         let ab = s.b - s.a;
         let l2 = ab.length_squared();
         let t = if l2 > 0.0 { ((q - s.a).dot(ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
@@ -181,9 +214,11 @@ impl Region {
         !self.curve.is_empty()
     }
 
-    /// Signed distance to the ply boundary curve (+∞ for the whole mesh): positive inside.
-    pub fn curve_distance(&self, q: DVec3) -> f64 {
-        self.curve.signed_distance(q)
+    /// Signed distance of the surface point `q` with unit normal `n` to the ply boundary curve
+    /// (+∞ for the whole mesh): positive inside. Only boundary segments on the same side of the
+    /// part as `q` count ([`Loops::signed_distance_facing`]).
+    pub fn curve_distance(&self, q: DVec3, n: DVec3) -> f64 {
+        self.curve.signed_distance_facing(q, n)
     }
 }
 
@@ -214,5 +249,22 @@ mod tests {
         assert!(l.signed_distance(DVec3::new(0.9, 0.9, 0.0)) > 0.0);
         // Outside beyond a convex corner.
         assert!(l.signed_distance(DVec3::new(-1.0, -1.0, 0.0)) < 0.0);
+    }
+
+    #[test]
+    fn only_segments_on_the_same_side_of_the_part_count() {
+        // A unit square on the top skin (normal +z) of a part 0.1 thick.
+        let lp: Vec<(DVec3, DVec3)> = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+            .iter()
+            .map(|&(x, y)| (DVec3::new(x, y, 0.1), DVec3::Z))
+            .collect();
+        let l = Loops::new(&[lp]);
+        let top = DVec3::new(0.5, 0.3, 0.1);
+        assert!((l.signed_distance_facing(top, DVec3::Z) - 0.3).abs() < 1e-12);
+        // Right under it on the bottom skin: inside by position, outside along the surface.
+        let bottom = DVec3::new(0.5, 0.3, 0.0);
+        assert!(l.signed_distance(bottom) > 0.0);
+        let d = l.signed_distance_facing(bottom, -DVec3::Z);
+        assert!(d < 0.0 && (d + (0.3f64 * 0.3 + 0.01).sqrt()).abs() < 1e-12, "{d}");
     }
 }

@@ -6,7 +6,8 @@
 //!   steered or geodesic, with smooth normals.
 //! - [`ply`]: covering a ply with parallel courses (seed 002 §3–4) — [`ply::plan`] is the entry
 //!   point — with [`section`] trimming every tow at the ply boundary ([`boundary`]) under a
-//!   coverage rule, and [`quality`] figures.
+//!   coverage rule, and [`quality`] figures; on a closed surface a closing course is trimmed
+//!   against the courses already laid ([`laid`]).
 //! - [`accuracy`]: deviations from closed-form geodesics on analytic surfaces (seed 001 §4).
 //! - [`output`]: courses as JSON, CSV and a G-code program.
 
@@ -18,6 +19,7 @@ pub mod boundary;
 pub mod course;
 pub mod field;
 pub mod input;
+pub mod laid;
 pub mod output;
 pub mod ply;
 pub mod quality;

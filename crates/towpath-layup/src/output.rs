@@ -240,15 +240,26 @@ impl Default for Post {
 }
 
 /// Head orientation A, B, C (degrees) of a frame with the fiber direction as x and the surface
-/// normal as z: R = Rz(C)·Ry(B)·Rx(A), columns (d, n × d, n).
+/// normal as z: R = Rx(A)·Ry(B)·Rz(C), columns (d, n × d, n). A and B tilt the tool axis onto the
+/// normal (n = (sin B, −sin A cos B, cos A cos B)); C turns the head about the tool axis last, so
+/// C is the heading: the same point laid the other way (d → −d) is C ± 180° with A and B
+/// unchanged, which is how `towpath optimize --bidirectional` reverses a course. Singular where
+/// the normal lies along ±X (B = ±90°): there A is taken as 0 and C carries the whole turn.
 pub fn abc(n: DVec3, d: DVec3) -> [f64; 3] {
-    let x = d.normalize_or_zero();
     let z = n.normalize_or_zero();
+    let x = (d - z * d.dot(z)).normalize_or_zero();
     let y = z.cross(x);
-    // R = [x y z] (columns); R[2][0] = x.z, R[2][1] = y.z, R[2][2] = z.z, R[1][0] = x.y, R[0][0] = x.x.
-    let b = (-x.z).clamp(-1.0, 1.0).asin();
-    let a = y.z.atan2(z.z);
-    let c = x.y.atan2(x.x);
+    // R = [x y z] (columns). Row 0 of Rx(A)·Ry(B)·Rz(C) is (cos B cos C, −cos B sin C, sin B);
+    // column 2 is (sin B, −sin A cos B, cos A cos B).
+    let b = z.x.clamp(-1.0, 1.0).asin();
+    let cb = (z.y * z.y + z.z * z.z).sqrt();
+    let (a, c) = if cb > 1e-12 {
+        ((-z.y).atan2(z.z), (-y.x).atan2(x.x))
+    } else {
+        // Gimbal lock: with A = 0, R = Ry(±90°)·Rz(C) has x = (0, sin C, ∓cos C) and
+        // y = (0, cos C, ±sin C).
+        (0.0, x.y.atan2(y.y))
+    };
     [a.to_degrees(), b.to_degrees(), c.to_degrees()]
 }
 

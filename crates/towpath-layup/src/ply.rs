@@ -13,6 +13,7 @@ use towpath_geom::Mesh;
 use crate::boundary::Region;
 use crate::course::Course;
 use crate::field::DirectionField;
+use crate::laid::LaidMap;
 use crate::quality::{self, PlyQuality};
 use crate::section::{Band, Coverage, Sectioner};
 use crate::trace::{reverse_walk, tangent, transport, walk, Located, PathPoint, Steering, Stop, WalkOptions};
@@ -124,6 +125,16 @@ pub enum PlyError {
     Empty,
 }
 
+/// The outcome of looking for the next course on one side.
+enum Next {
+    /// A new centreline.
+    Course(Vec<PathPoint>),
+    /// No room: every candidate lands on courses already laid (the surface closes on itself).
+    Blocked,
+    /// No more ply on this side.
+    End,
+}
+
 /// Progress report: courses generated so far.
 pub type Progress<'a> = &'a mut dyn FnMut(usize);
 
@@ -133,7 +144,9 @@ struct Planner<'a> {
     region: &'a Region,
     spec: &'a PlySpec,
     /// Course centreline points laid so far (for wrap-around detection): a coarse grid.
-    grid: std::collections::HashMap<[i64; 3], Vec<DVec3>>,
+    /// Each point with the lateral index of its course (0 the reference, +k / −k the k-th course
+    /// to the left / right).
+    grid: std::collections::HashMap<[i64; 3], Vec<(DVec3, i32)>>,
     max_len: f64,
 }
 
@@ -160,7 +173,7 @@ pub fn plan(
     let start_pt = spec.start.unwrap_or_else(|| default_start(mesh, region));
     let sp = mesh.closest_point(start_pt).ok_or(PlyError::Empty)?;
     let start = Located::new(mesh, sp);
-    if region.has_curve() && region.curve_distance(start.p) < 0.0 {
+    if region.has_curve() && region.curve_distance(start.p, start.n) < 0.0 {
         return Err(PlyError::StartOutside(start.p.to_array()));
     }
     let d0 = field.direction(start.p, start.n).ok_or(PlyError::NoDirection(start.p.to_array()))?;
@@ -169,28 +182,53 @@ pub fn plan(
         Method::Parallel | Method::Natural => Steering::Geodesic,
     };
     let reference = pl.trace(start, d0, method_steer);
-    pl.remember(&reference);
+    pl.remember(&reference, 0);
     let mut done = 1usize;
     progress(done);
     let n_estimate = pl.estimate(&reference);
     let mut sides: [Vec<Vec<PathPoint>>; 2] = [Vec::new(), Vec::new()];
+    // Whether a side stopped because its next course would land on a course laid more than two
+    // courses away from it: the surface closes on itself across the fibers (a helical ply on a
+    // tube).
+    let mut blocked = false;
     for (si, sign) in [(0usize, 1.0f64), (1, -1.0)] {
         let mut prev = reference.clone();
+        let mut prev_index = 0i32;
         while done < spec.max_courses {
-            let next = match spec.method {
-                Method::Parallel => pl.parallel(&prev, sign),
-                Method::Field | Method::Natural => pl.seeded(&prev, sign, method_steer),
+            let next = pl.next_course(&prev, prev_index, sign, method_steer, false);
+            let next = match next {
+                Next::Course(c) => c,
+                Next::Blocked => {
+                    blocked = true;
+                    break;
+                }
+                Next::End => break,
             };
-            let Some(next) = next else { break };
-            pl.remember(&next);
+            prev_index += sign as i32;
+            pl.remember(&next, prev_index);
             done += 1;
             progress(done);
             sides[si].push(next.clone());
             prev = next;
         }
     }
+    // On a closed surface the courses leave a strip narrower than a course where the last course
+    // meets the first. One closing course is laid over it, right of the rightmost course (else
+    // left of the leftmost), with its tows trimmed against the courses already laid under the
+    // coverage rule, as at the ply boundary.
+    let mut closing: Option<(i8, Vec<PathPoint>)> = None;
+    if blocked && done < spec.max_courses {
+        for (si, sign) in [(1usize, -1.0f64), (0, 1.0)] {
+            let prev = sides[si].last().unwrap_or(&reference);
+            let prev_index = sign as i32 * sides[si].len() as i32;
+            if let Next::Course(c) = pl.next_course(prev, prev_index, sign, method_steer, true) {
+                closing = Some((sign as i8, c));
+                break;
+            }
+        }
+    }
     let [left, right] = sides;
-    let (n1, n2) = (left.len(), right.len());
+    let (mut n1, mut n2) = (left.len(), right.len());
     // Lateral order: rightmost first.
     let mut lines: Vec<(i8, usize, Vec<PathPoint>)> = Vec::new();
     for (i, c) in right.into_iter().enumerate().rev() {
@@ -202,7 +240,7 @@ pub fn plan(
     }
     timings.courses = tp.elapsed().as_secs_f64();
     let tp = Instant::now();
-    let sectioner = Sectioner { mesh, region, band: spec.band() };
+    let sectioner = Sectioner { mesh, region, band: spec.band(), occupied: None };
     // Courses are trimmed independently (in parallel; the result does not depend on threads).
     let prepared: Vec<(i8, usize, Vec<PathPoint>, Vec<bool>)> = lines
         .into_iter()
@@ -211,15 +249,43 @@ pub fn plan(
             (side, offset_index, pts, on)
         })
         .collect();
-    let mut courses: Vec<Course> = prepared
-        .into_par_iter()
-        .map(|(side, offset_index, pts, on_surface)| {
-            let tows = sectioner.trim(&pts, spec.coverage, spec.station_step, 1e-3);
-            let mut c = Course { id: 0, side, offset_index, points: pts, on_surface, tows };
-            crop(&mut c);
-            c
-        })
-        .collect();
+    // `shortest`: laid pieces shorter than this are dropped.
+    let trim = |sectioner: &Sectioner<'_>,
+                (side, offset_index, pts, on_surface): (i8, usize, Vec<PathPoint>, Vec<bool>),
+                shortest: f64| {
+        let mut tows = sectioner.trim(&pts, spec.coverage, spec.station_step, 1e-3);
+        for ivs in &mut tows {
+            ivs.retain(|iv| iv[1] - iv[0] >= shortest);
+        }
+        let mut c = Course { id: 0, side, offset_index, points: pts, on_surface, tows };
+        crop(&mut c);
+        c
+    };
+    let mut courses: Vec<Course> = prepared.into_par_iter().map(|x| trim(&sectioner, x, 0.0)).collect();
+    if let Some((side, pts)) = closing {
+        // Lines over laid tows (by more than a twentieth of a tow, 0.32 mm for 6.35 mm tows, so
+        // that abutting edges are free despite the tangent-plane offsets of [`LaidMap`]) count as
+        // outside the ply for the closing course.
+        let laid = LaidMap::new(&courses, spec.band());
+        let inset = 0.05 * spec.tow_width;
+        let occupied = |q: DVec3| laid.covers(q, inset);
+        let closing_sectioner = Sectioner { mesh, region, band: spec.band(), occupied: Some(&occupied) };
+        let offset_index = if side < 0 { n2 + 1 } else { n1 + 1 };
+        let (pts, on) = pl.run_out(pts);
+        // The closing course fills the strip along its length; the slivers of free surface it
+        // also finds where other courses end at the boundary are not worth a tow restart: pieces
+        // shorter than one course width are dropped.
+        let c = trim(&closing_sectioner, (side, offset_index, pts, on), pl.width());
+        if c.laid_range().is_some() {
+            if side < 0 {
+                n2 += 1;
+                courses.insert(0, c);
+            } else {
+                n1 += 1;
+                courses.push(c);
+            }
+        }
+    }
     courses.retain(|c| c.laid_range().is_some());
     for (i, c) in courses.iter_mut().enumerate() {
         c.id = i;
@@ -258,7 +324,7 @@ impl Planner<'_> {
         [f.x.floor() as i64, f.y.floor() as i64, f.z.floor() as i64]
     }
 
-    fn remember(&mut self, pts: &[PathPoint]) {
+    fn remember(&mut self, pts: &[PathPoint], lateral: i32) {
         let mut last: Option<DVec3> = None;
         for q in pts {
             if last.is_some_and(|l| l.distance(q.p) < 0.1 * self.width()) {
@@ -266,20 +332,24 @@ impl Planner<'_> {
             }
             last = Some(q.p);
             let k = self.key(q.p);
-            self.grid.entry(k).or_default().push(q.p);
+            self.grid.entry(k).or_default().push((q.p, lateral));
         }
     }
 
-    /// Distance to the nearest remembered course point (within one course width; else ∞).
-    fn near_existing(&self, p: DVec3) -> f64 {
+    /// Distance to the nearest remembered course point (within one course width; else ∞) and the
+    /// lateral index of its course.
+    fn near_existing(&self, p: DVec3) -> (f64, i32) {
         let c = self.key(p);
-        let mut best = f64::INFINITY;
+        let mut best = (f64::INFINITY, 0);
         for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
                     if let Some(v) = self.grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
-                        for q in v {
-                            best = best.min(q.distance(p));
+                        for &(q, lateral) in v {
+                            let d = q.distance(p);
+                            if d < best.0 {
+                                best = (d, lateral);
+                            }
                         }
                     }
                 }
@@ -289,13 +359,13 @@ impl Planner<'_> {
     }
 
     /// Whether a course centre at p would still put material in the ply.
-    fn useful(&self, p: DVec3) -> bool {
-        !self.region.has_curve() || self.region.curve_distance(p) > -0.5 * self.width()
+    fn useful(&self, p: DVec3, n: DVec3) -> bool {
+        !self.region.has_curve() || self.region.curve_distance(p, n) > -0.5 * self.width()
     }
 
     /// The stop test of centreline traces: far outside the ply boundary.
-    fn outside_far(&self, p: DVec3) -> bool {
-        self.region.has_curve() && self.region.curve_distance(p) < -1.5 * self.width()
+    fn outside_far(&self, p: DVec3, n: DVec3) -> bool {
+        self.region.has_curve() && self.region.curve_distance(p, n) < -1.5 * self.width()
     }
 
     /// Traces a centreline in both directions from `start`. A closed loop (a hoop on a tube) is
@@ -311,7 +381,7 @@ impl Planner<'_> {
         let mut closed = false;
         let mut last = start.p;
         let (mut fwd, _) = walk(self.mesh, start, d_start, steer, &opts, |q| {
-            if self.outside_far(q.p) {
+            if self.outside_far(q.p, q.n) {
                 return true;
             }
             // Back at the start (a hoop): the step from the previous point passes the start.
@@ -338,7 +408,7 @@ impl Planner<'_> {
         let bwd = if closed {
             Vec::new()
         } else {
-            walk(self.mesh, start, -d_start, steer, &opts, |q| self.outside_far(q.p)).0
+            walk(self.mesh, start, -d_start, steer, &opts, |q| self.outside_far(q.p, q.n)).0
         };
         let total_b = bwd.last().map_or(0.0, |q| q.s);
         let mut pts = Vec::with_capacity(fwd.len() + bwd.len() + 1);
@@ -381,12 +451,36 @@ impl Planner<'_> {
         Some((loc, d))
     }
 
+    /// The next course one width across from `prev` towards `sign` for the ply's method;
+    /// `on_existing` allows it to land on courses already laid (the closing course).
+    /// `prev_index` is the lateral index of `prev`.
+    fn next_course(
+        &self,
+        prev: &[PathPoint],
+        prev_index: i32,
+        sign: f64,
+        steer: Steering<'_>,
+        on_existing: bool,
+    ) -> Next {
+        match self.spec.method {
+            Method::Parallel => self.parallel(prev, prev_index, sign, on_existing),
+            Method::Field | Method::Natural => self.seeded(prev, prev_index, sign, steer, on_existing),
+        }
+    }
+
+    /// Whether a course of lateral index `owner` met by the next course after `prev_index` lies
+    /// round a closed surface rather than beside it.
+    fn wraps(owner: i32, prev_index: i32) -> bool {
+        (owner - prev_index).abs() > 2
+    }
+
     /// Next course for the field and natural methods: seeded one course width across from the
-    /// previous course (at the point nearest the previous seed that lands in the ply and not on
-    /// an existing course), then traced.
-    fn seeded(&self, prev: &[PathPoint], sign: f64, steer: Steering<'_>) -> Option<Vec<PathPoint>> {
+    /// previous course (at the point nearest the previous seed that lands in the ply and, unless
+    /// `on_existing`, not on an existing course), then traced.
+    fn seeded(&self, prev: &[PathPoint], prev_index: i32, sign: f64, steer: Steering<'_>, on_existing: bool) -> Next {
         let w = self.width();
-        let len = prev.last()?.s;
+        let Some(len) = prev.last().map(|q| q.s) else { return Next::End };
+        let mut blocked = false;
         // Candidate stations every w/2, nearest the middle first.
         let mid = 0.5 * len;
         let count = (len / (0.5 * w)).ceil() as usize + 1;
@@ -394,12 +488,17 @@ impl Planner<'_> {
         cands.sort_by(|a, b| (a - mid).abs().total_cmp(&(b - mid).abs()));
         for s in cands {
             let (p, n, d) = crate::course::frame_at(prev, s);
-            if !self.useful(p) {
+            if !self.useful(p, n) {
                 continue;
             }
             let at = PathPoint { p, n, d, s, face: crate::course::face_hint(prev, s) };
             let Some((loc, dt)) = self.across(&at, sign, w, true) else { continue };
-            if !self.useful(loc.p) || self.near_existing(loc.p) < 0.5 * w {
+            if !self.useful(loc.p, loc.n) {
+                continue;
+            }
+            let (dist, owner) = self.near_existing(loc.p);
+            if !on_existing && dist < 0.5 * w {
+                blocked |= Self::wraps(owner, prev_index);
                 continue;
             }
             let d0 = match steer {
@@ -412,23 +511,41 @@ impl Planner<'_> {
             let Some(d0) = d0 else { continue };
             let pts = self.trace(loc, d0, steer);
             if pts.len() >= 2 {
-                return Some(pts);
+                return Next::Course(pts);
             }
         }
-        None
+        if blocked {
+            Next::Blocked
+        } else {
+            Next::End
+        }
     }
 
     /// Next course for the parallel method: the geodesic offset of every station of the previous
     /// course, extended at both ends along geodesics to the ply (seed 002 §4).
-    fn parallel(&self, prev: &[PathPoint], sign: f64) -> Option<Vec<PathPoint>> {
+    fn parallel(&self, prev: &[PathPoint], prev_index: i32, sign: f64, on_existing: bool) -> Next {
         // Whole-width offsets first; only where none fits (the last strip before a mesh edge) is
         // the course shifted onto the surface.
-        self.parallel_with(prev, sign, false).or_else(|| self.parallel_with(prev, sign, true))
+        match self.parallel_with(prev, prev_index, sign, false, on_existing) {
+            Next::Course(c) => Next::Course(c),
+            first => match self.parallel_with(prev, prev_index, sign, true, on_existing) {
+                Next::Course(c) => Next::Course(c),
+                Next::Blocked => Next::Blocked,
+                Next::End => first,
+            },
+        }
     }
 
-    fn parallel_with(&self, prev: &[PathPoint], sign: f64, allow_shift: bool) -> Option<Vec<PathPoint>> {
+    fn parallel_with(
+        &self,
+        prev: &[PathPoint],
+        prev_index: i32,
+        sign: f64,
+        allow_shift: bool,
+        on_existing: bool,
+    ) -> Next {
         let w = self.width();
-        let len = prev.last()?.s;
+        let Some(len) = prev.last().map(|q| q.s) else { return Next::End };
         let step = (0.1 * w).clamp(1.0, 10.0);
         let count = (len / step).ceil() as usize;
         let mut pts: Vec<PathPoint> = Vec::new();
@@ -445,13 +562,16 @@ impl Planner<'_> {
             }
             pts.push(PathPoint { p: loc.p, n: loc.n, d: dt, s: 0.0, face: NO_FACE });
         }
-        let useful = pts.iter().filter(|q| self.useful(q.p)).count();
+        let useful = pts.iter().filter(|q| self.useful(q.p, q.n)).count();
         if useful == 0 {
-            return None;
+            return Next::End;
         }
-        let covered = pts.iter().filter(|q| self.near_existing(q.p) < 0.5 * w).count();
-        if covered * 2 > pts.len() {
-            return None; // wrapped onto existing courses (closed surface)
+        let near: Vec<(f64, i32)> = pts.iter().map(|q| self.near_existing(q.p)).collect();
+        let covered = near.iter().filter(|x| x.0 < 0.5 * w).count();
+        if !on_existing && covered * 2 > pts.len() {
+            let wrapped = near.iter().filter(|x| x.0 < 0.5 * w && Self::wraps(x.1, prev_index)).count();
+            // Wrapped onto courses round a closed surface, or folded onto its neighbours.
+            return if wrapped * 2 > pts.len() { Next::Blocked } else { Next::End };
         }
         let closed = prev.len() > 2 && prev[0].p.distance(prev[prev.len() - 1].p) < 0.02 * w;
         if closed {
@@ -467,16 +587,15 @@ impl Planner<'_> {
                 }
                 all[i].s = s;
             }
-            return Some(all);
+            return Next::Course(all);
         }
         // Extend both ends geodesically until leaving the ply or the mesh.
         let opts = WalkOptions::up_to(self.max_len);
         let ext = |q: &PathPoint, dir: DVec3| -> Vec<PathPoint> {
             let Some(loc) = crate::course::locate(self.mesh, q.p, q.face) else { return Vec::new() };
-            walk(self.mesh, loc, dir, Steering::Geodesic, &opts, |x| self.outside_far(x.p)).0
+            walk(self.mesh, loc, dir, Steering::Geodesic, &opts, |x| self.outside_far(x.p, x.n)).0
         };
-        let first = *pts.first()?;
-        let last = *pts.last()?;
+        let (Some(&first), Some(&last)) = (pts.first(), pts.last()) else { return Next::End };
         let head = ext(&first, -first.d);
         let tail = ext(&last, last.d);
         let mut all: Vec<PathPoint> = reverse_walk(&head, NO_FACE);
@@ -492,7 +611,7 @@ impl Planner<'_> {
             }
             all[i].s = s;
         }
-        Some(all)
+        Next::Course(all)
     }
 
     /// Adds straight run-outs beyond the mesh edge at ends where the centreline stopped on the
@@ -550,7 +669,7 @@ impl Planner<'_> {
         for i in 0..=count {
             let s = len * i as f64 / count as f64;
             let (p, n, d) = crate::course::frame_at(reference, s);
-            if self.region.has_curve() && self.region.curve_distance(p) < 0.0 {
+            if self.region.has_curve() && self.region.curve_distance(p, n) < 0.0 {
                 continue;
             }
             let Some(start) = crate::course::locate(self.mesh, p, crate::course::face_hint(reference, s)) else {
@@ -560,7 +679,7 @@ impl Planner<'_> {
                 let b = n.cross(d) * sign;
                 let opts = WalkOptions::up_to(self.max_len);
                 let (wk, _) = walk(self.mesh, start, b, Steering::Geodesic, &opts, |q| {
-                    (self.region.has_curve() && self.region.curve_distance(q.p) < 0.0)
+                    (self.region.has_curve() && self.region.curve_distance(q.p, q.n) < 0.0)
                         || (q.s > w && q.p.distance(start.p) < 0.02 * w)
                 });
                 let l = wk.last().map_or(0.0, |q| q.s);
@@ -582,8 +701,18 @@ fn crop(c: &mut Course) {
         let i = c.points.partition_point(|q| q.s < s).min(c.points.len().saturating_sub(1));
         c.points.get(i).map_or(NO_FACE, |q| q.face)
     };
+    // A new end point is on the surface only if the segment it lies in is (both its ends are): an
+    // end cut inside a run-out is off the mesh even when the next point is on it.
+    let flag_at = |s: f64| {
+        let i = c.points.partition_point(|q| q.s < s);
+        match (c.points.get(i), c.on_surface.get(i)) {
+            (Some(q), Some(&o)) if (q.s - s).abs() <= 1e-9 => o,
+            _ => c.on_surface_at(s),
+        }
+    };
+    let (on_a, on_b) = (flag_at(a), flag_at(b));
     let mut pts = vec![PathPoint { p: pa, n: na, d: da, s: a, face: NO_FACE }];
-    let mut on = vec![c.on_surface.get(c.points.partition_point(|q| q.s < a)).copied().unwrap_or(true)];
+    let mut on = vec![on_a];
     for (q, &o) in c.points.iter().zip(&c.on_surface) {
         if q.s > a + 1e-9 && q.s < b - 1e-9 {
             pts.push(*q);
@@ -591,12 +720,7 @@ fn crop(c: &mut Course) {
         }
     }
     pts.push(PathPoint { p: pb, n: nb, d: db, s: b, face: face_at(b) });
-    on.push(
-        c.on_surface
-            .get(c.points.partition_point(|q| q.s < b).min(c.points.len().saturating_sub(1)))
-            .copied()
-            .unwrap_or(true),
-    );
+    on.push(on_b);
     // Re-base arc length to start at zero.
     for q in &mut pts {
         q.s -= a;

@@ -13,7 +13,9 @@ use towpath_geom::Mesh;
 use crate::boundary::Region;
 use crate::course::Course;
 use crate::field::DirectionField;
+use crate::laid::LaidMap;
 use crate::ply::PlySpec;
+use crate::section::Band;
 use crate::trace::{walk, PathPoint, Steering, WalkOptions};
 
 /// Per-point figures of one course (same length as its points).
@@ -270,19 +272,7 @@ pub fn assess(
     }
     // Coverage: area-weighted face-centroid samples inside the ply, each checked against the laid
     // tows of the nearest course stations.
-    let mut stations: Vec<(usize, f64)> = Vec::new();
-    let mut items: Vec<Indexed> = Vec::new();
-    let sstep = (0.25 * w).clamp(1.0, 10.0);
-    for (ci, c) in courses.iter().enumerate() {
-        let len = c.length();
-        let count = (len / sstep).ceil().max(1.0) as usize;
-        for j in 0..=count {
-            let s = len * j as f64 / count as f64;
-            items.push(Indexed::new(c.frame_at(s).0.to_array(), stations.len() as u32));
-            stations.push((ci, s));
-        }
-    }
-    let tree = RTree::bulk_load(items);
+    let laid = LaidMap::new(courses, Band { tow_width: spec.tow_width, tows: spec.tows });
     // Samples: every face split into m × m sub-triangles (m from the face size and a spacing of
     // half a tow width, within a budget), one sample at each sub-triangle's centroid.
     let nf = mesh.num_faces();
@@ -306,6 +296,7 @@ pub fn assess(
         .par_iter()
         .map(|&f| {
             let c = mesh.corners(f);
+            let nf = mesh.face_normal(f);
             let m = (edge_max(f) / h).ceil().clamp(1.0, 16.0) as usize;
             let a = mesh.face_area(f) / (m * m) as f64;
             let (mut area, mut covered) = (0.0, 0.0);
@@ -319,11 +310,11 @@ pub fn assess(
                     for (u, v) in pts {
                         let (u, v) = (u / m as f64, v / m as f64);
                         let x = c[0] * (1.0 - u - v) + c[1] * u + c[2] * v;
-                        if region.has_curve() && region.curve_distance(x) < 0.0 {
+                        if region.has_curve() && region.curve_distance(x, nf) < 0.0 {
                             continue;
                         }
                         area += a;
-                        if covered_point(&tree, &stations, courses, x, sstep, spec) {
+                        if laid.covers(x, 0.0) {
                             covered += a;
                         }
                     }
@@ -340,42 +331,4 @@ pub fn assess(
     pq.ply_area = area * stride as f64;
     pq.coverage_percent = if area > 0.0 { 100.0 * covered / area } else { 0.0 };
     pq
-}
-
-/// Whether point x is under a laid tow of one of the nearest course stations.
-fn covered_point(
-    tree: &RTree<Indexed>,
-    stations: &[(usize, f64)],
-    courses: &[Course],
-    x: DVec3,
-    sstep: f64,
-    spec: &PlySpec,
-) -> bool {
-    for nn in tree.nearest_neighbor_iter(&x.to_array()).take(6) {
-        let (ci, s) = stations[nn.data as usize];
-        let cr = &courses[ci];
-        let (p, _, d) = cr.frame_at(s);
-        // Slide to the foot of the perpendicular along the course.
-        let along = (x - p).dot(d);
-        let sf = s + along;
-        let (p2, n2, d2) = cr.frame_at(sf);
-        let v2 = x - p2;
-        if v2.dot(d2).abs() > 0.5 * sstep + 1e-9 {
-            continue;
-        }
-        if covered_by(cr, v2.dot(n2.cross(d2)), sf, spec) {
-            return true;
-        }
-    }
-    false
-}
-
-fn covered_by(c: &Course, lateral: f64, s: f64, spec: &PlySpec) -> bool {
-    let w = spec.tow_width * spec.tows as f64;
-    let x = lateral + 0.5 * w;
-    if !(0.0..=w).contains(&x) {
-        return false;
-    }
-    let k = ((x / spec.tow_width) as usize).min(spec.tows - 1);
-    c.laid(k, s)
 }

@@ -104,12 +104,15 @@ pub struct Sectioner<'a> {
     pub region: &'a Region,
     /// The band.
     pub band: Band,
+    /// Surface already covered (by other courses): lines there count as outside the ply, so a
+    /// closing course is trimmed against the courses laid before it under the same rule.
+    pub occupied: Option<&'a (dyn Fn(DVec3) -> bool + Sync)>,
 }
 
 impl Sectioner<'_> {
-    /// Inside test of a point known to be on the mesh.
-    fn inside_curve(&self, q: DVec3) -> bool {
-        !self.region.has_curve() || self.region.curve_distance(q) >= 0.0
+    /// Inside test of a point known to be on the mesh, with the surface normal near it.
+    fn inside_curve(&self, q: DVec3, n: DVec3) -> bool {
+        (!self.region.has_curve() || self.region.curve_distance(q, n) >= 0.0) && !self.occupied.is_some_and(|f| f(q))
     }
 
     /// Whether a point near the mesh edge (possibly off the surface) lies over the mesh rather than
@@ -143,7 +146,7 @@ impl Sectioner<'_> {
         let (p, n, d) = frame_at(points, s);
         let half = 0.5 * self.band.width();
         let margin = half + self.band.tow_width;
-        let sd = self.region.curve_distance(p);
+        let sd = self.region.curve_distance(p, n);
         if sd < -margin {
             return vec![false; offsets.len()];
         }
@@ -155,7 +158,7 @@ impl Sectioner<'_> {
             let nf = self.mesh.face_normal(l.sp.face);
             (v - nf * v.dot(nf)).length() <= 1e-3 * self.band.tow_width
         });
-        if centre_on_mesh && sd > margin && self.region.mesh_edges.distance(p) > margin {
+        if centre_on_mesh && sd > margin && self.region.mesh_edges.distance(p) > margin && self.occupied.is_none() {
             return vec![true; offsets.len()];
         }
         let b = n.cross(d).normalize_or_zero();
@@ -178,21 +181,21 @@ impl Sectioner<'_> {
                     let (w, stop) = if o >= 0.0 { (&left, stop_l) } else { (&right, stop_r) };
                     let a = o.abs();
                     if a <= 1e-12 {
-                        inside[i] = self.inside_curve(start.p);
+                        inside[i] = self.inside_curve(start.p, start.n);
                         continue;
                     }
                     let reach = w.last().map_or(0.0, |q| q.s);
                     if reach + 1e-9 < a && stop != Stop::Length {
                         continue; // the mesh ends before this line
                     }
-                    inside[i] = self.inside_curve(point_at(start.p, w, a));
+                    inside[i] = self.inside_curve(point_at(start.p, w, a), start.n);
                 }
             }
             _ => {
                 // The centre is beyond the mesh (a run-out): offsets in the tangent plane.
                 for (i, &o) in offsets.iter().enumerate() {
                     let q = p + b * o;
-                    inside[i] = self.on_mesh(q) && self.inside_curve(q);
+                    inside[i] = self.on_mesh(q) && self.inside_curve(q, n);
                 }
             }
         }

@@ -47,15 +47,17 @@ fn cylinder_helix_ply_with_gcode_and_csv() {
         ],
     );
     let s = json_of(&out);
-    // 45° courses of 101.6 mm on a tube of circumference 1885 mm: 1885 cos 45° / 101.6 = 13.1.
-    assert_eq!(s["courses"], 13);
+    // 45° courses of 101.6 mm on a tube of circumference 1885 mm: 1885 cos 45° / 101.6 = 13.1:
+    // 13 whole courses and a closing course laying the tows that fill the 12 mm strip left.
+    assert_eq!(s["courses"], 14);
+    assert!(s["coverage_percent"].as_f64().unwrap() > 99.5, "{s}");
     assert!(s["max_angle_deviation_deg"].as_f64().unwrap() < 0.05);
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(d.join("c.json")).unwrap()).unwrap();
     assert_eq!(doc["format"], "towpath-courses");
-    assert_eq!(doc["courses"].as_array().unwrap().len(), 13);
+    assert_eq!(doc["courses"].as_array().unwrap().len(), 14);
     let g = std::fs::read_to_string(d.join("c.nc")).unwrap();
     assert!(g.starts_with("(towpath layup"));
-    assert_eq!(g.matches("(COURSE ").count(), 13);
+    assert_eq!(g.matches("(COURSE ").count(), 14);
     assert!(std::fs::read_to_string(d.join("c.csv")).unwrap().starts_with("course,point,s,x,y,z"));
 }
 
@@ -249,4 +251,103 @@ fn nurbs_patch_surface_is_tessellated_and_covered() {
         towpath(&d, &["layup", "nurbs:bad.json", "--angle", "0", "--tow-width", "6.35", "--tows", "8", "-o", "b.json"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("bad.json"));
+}
+
+const SIX_AXIS: &str = r#"name = "six-axis"
+[[axis]]
+label = "X"
+kind = "linear"
+[[axis]]
+label = "Y"
+kind = "linear"
+[[axis]]
+label = "Z"
+kind = "linear"
+[[axis]]
+label = "A"
+kind = "rotary"
+[[axis]]
+label = "B"
+kind = "rotary"
+[[axis]]
+label = "C"
+kind = "continuous"
+heading = true
+"#;
+
+/// Every laying move of a program runs along the head's fiber axis (x of R = Rx(A)·Ry(B)·Rz(C))
+/// with the tool axis (z) across it; returns the number of moves checked.
+fn moves_follow_the_head_frame(text: &str, machine: &towpath_machine::Machine) -> usize {
+    let p = towpath_nc::parse(text, machine, &towpath_nc::Dialect::default()).expect("program parses");
+    let mut checked = 0;
+    for s in p.segments.iter().filter(|s| s.on_part) {
+        let (a, b) = (p.point(s.from), p.point(s.to));
+        let chord = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let len = (chord[0] * chord[0] + chord[1] * chord[1] + chord[2] * chord[2]).sqrt();
+        if len < 0.5 {
+            continue; // rounding dominates short moves
+        }
+        let (sa, ca) = b[3].to_radians().sin_cos();
+        let (sb, cb) = b[4].to_radians().sin_cos();
+        let (sc, cc) = b[5].to_radians().sin_cos();
+        // Columns of Rx(A)·Ry(B)·Rz(C): x (fiber) and z (tool axis).
+        let x = [cb * cc, ca * sc + sa * sb * cc, sa * sc - ca * sb * cc];
+        let z = [sb, -sa * cb, ca * cb];
+        let dot = |u: [f64; 3]| (u[0] * chord[0] + u[1] * chord[1] + u[2] * chord[2]) / len;
+        assert!(dot(x) > 0.99, "line {}: fiber axis {x:?} against the move {chord:?}", s.line + 1);
+        assert!(dot(z).abs() < 0.05, "line {}: tool axis {z:?} not across the move {chord:?}", s.line + 1);
+        checked += 1;
+    }
+    checked
+}
+
+#[test]
+fn layup_gcode_is_optimized_bidirectionally_and_verified() {
+    let d = tmp("gcode");
+    std::fs::write(d.join("six-axis.toml"), SIX_AXIS).unwrap();
+    let machine = towpath_machine::Machine::from_toml_str(SIX_AXIS).unwrap();
+    let out = towpath(
+        &d,
+        &[
+            "layup",
+            "cylinder:r=300,l=400,a0=30,a1=150",
+            "--angle",
+            "-45",
+            "--axis",
+            "0,0,1",
+            "--tow-width",
+            "6.35",
+            "--tows",
+            "8",
+            "--triangles",
+            "8000",
+            "--ply-number",
+            "2",
+            "-o",
+            "ply.json",
+            "--gcode",
+            "ply.nc",
+            "--json",
+        ],
+    );
+    let s = json_of(&out);
+    let courses = s["courses"].as_u64().unwrap();
+    assert!(courses >= 10, "{s}");
+    let original = std::fs::read_to_string(d.join("ply.nc")).unwrap();
+    assert!(moves_follow_the_head_frame(&original, &machine) > 100);
+    let common = ["--machine", "six-axis.toml", "--tow-width", "6.35"];
+    let mut args = vec!["optimize", "ply.nc", "--bidirectional", "--time-limit", "1", "-o", "opt.nc", "--json"];
+    args.extend(common);
+    let r = json_of(&towpath(&d, &args));
+    assert_eq!(r["courses"].as_u64(), Some(courses), "{r}");
+    assert!(r["reversed"].as_u64().unwrap() > 0, "a ply laid all one way has courses to reverse: {r}");
+    // The optimized program lays the same courses, some reversed (heading C ± 180°): the head
+    // still points along every laying move.
+    let optimized = std::fs::read_to_string(d.join("opt.nc")).unwrap();
+    assert!(moves_follow_the_head_frame(&optimized, &machine) > 100);
+    let mut args = vec!["verify", "ply.nc", "opt.nc", "--json"];
+    args.extend(common);
+    let v = json_of(&towpath(&d, &args));
+    assert_eq!(v["verified"], true, "{v}");
+    assert_eq!(v["courses"].as_u64(), Some(courses));
 }

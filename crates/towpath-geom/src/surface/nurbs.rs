@@ -317,6 +317,25 @@ mod tests {
     }
 
     #[test]
+    fn rational_patch_tessellation_meets_both_tolerances() {
+        // The quarter cylinder (R 2, height 3) under D_l2s = 0.002 and L_seg = 0.3: every edge at
+        // most L_seg long and its midpoint within D_l2s of the exact cylinder.
+        let s = quarter_cylinder();
+        let (d, l) = (0.002, 0.3);
+        let soup = crate::surface::tessellate(&s, &crate::surface::Tessellation::Chord { d_l2s: d, l_seg: l }).unwrap();
+        assert!(soup.triangles.len() > 50);
+        for t in &soup.triangles {
+            for k in 0..3 {
+                let (a, b) = (soup.positions[t[k] as usize], soup.positions[t[(k + 1) % 3] as usize]);
+                assert!(a.distance(b) <= l + 1e-9, "edge {}", a.distance(b));
+                let m = (a + b) * 0.5;
+                let dev = 2.0 - (m.x * m.x + m.y * m.y).sqrt();
+                assert!((-1e-12..=d + 1e-9).contains(&dev), "deviation {dev}");
+            }
+        }
+    }
+
+    #[test]
     fn clamped_bilinear_patch_is_the_plane_and_closest_point_works() {
         let grid = vec![
             vec![

@@ -10,7 +10,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use super::local::LocalSearch;
-use super::modes::optimize_modes;
+use super::modes::{optimize_modes, optimize_modes_noting};
 use super::neighbors::Neighbors;
 use super::net::Net;
 use super::tour::Tour;
@@ -53,7 +53,11 @@ impl Chain {
 #[derive(Clone, Copy)]
 pub(crate) struct Budget {
     pub kicks: u64,
+    /// No new kick after this (the end of an epoch or of the search).
     pub deadline: Option<Instant>,
+    /// The end of the search: a local search still running then is cut short and its kick
+    /// undone, so that the best tour is always a local optimum.
+    pub hard: Option<Instant>,
 }
 
 pub(crate) struct Ils<'a, 'p, C> {
@@ -97,20 +101,20 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
     pub fn run(&self, state: &mut Chain, budget: Budget, cancel: Option<&AtomicBool>) -> u64 {
         let Chain { cur, best, rng, stagnation } = state;
         let mut ls = LocalSearch::new(self.net, self.nb, self.eps);
-        ls.deadline = budget.deadline;
+        ls.deadline = budget.hard;
         let n = cur.len();
         let mut kicks = 0u64;
+        let mut changed = Vec::new();
         if n < 3 {
             return 0;
         }
         while kicks < budget.kicks {
-            if kicks & 15 == 0 {
-                if budget.deadline.is_some_and(|d| Instant::now() >= d) {
-                    break;
-                }
-                if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
-                    break;
-                }
+            // A kick costs microseconds at least, reading the clock tens of nanoseconds.
+            if budget.deadline.is_some_and(|d| Instant::now() >= d) {
+                break;
+            }
+            if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+                break;
             }
             kicks += 1;
             if *stagnation >= 16 * n as u64 + 200 {
@@ -130,6 +134,9 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
                 }
                 ls.run(cur);
                 cur.commit();
+                if ls.cut {
+                    break;
+                }
                 continue;
             }
             let before = cur.cost;
@@ -150,9 +157,23 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
                 optimize_modes(self.net, cur, self.eps);
             }
             ls.run(cur);
-            if self.dp_each_kick && optimize_modes(self.net, cur, self.eps) {
-                ls.push_all(cur);
-                ls.run(cur);
+            if self.dp_each_kick {
+                // re-examine only around the nodes whose mode the DP changed
+                changed.clear();
+                if optimize_modes_noting(self.net, cur, self.eps, &mut changed) {
+                    for &v in &changed {
+                        let p = cur.pos[v as usize] as usize;
+                        ls.push(v);
+                        ls.push(cur.seq[if p == 0 { n - 1 } else { p - 1 }]);
+                        ls.push(cur.next_of_pos(p));
+                    }
+                    ls.run(cur);
+                }
+            }
+            if ls.cut {
+                // out of time in the middle of the local search
+                cur.undo();
+                break;
             }
             *stagnation += 1;
             if cur.cost <= before + self.eps * 0.5 {

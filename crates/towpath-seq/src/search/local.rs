@@ -40,6 +40,9 @@ pub(crate) struct LocalSearch<'a, 'p, C> {
     /// Scan at most this many positions each way when precedence forces scanning.
     scan_limit: usize,
     pub deadline: Option<Instant>,
+    /// Set when a run stopped at the deadline with work left (the tour may not be a local
+    /// optimum).
+    pub cut: bool,
     /// Moves applied since creation (for statistics).
     pub moves: u64,
     /// Endpoints of the arcs changed by the current Lin–Kernighan chain.
@@ -68,6 +71,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             two_opt: net.reversal_symmetric && !net.has_prec,
             scan_limit: SCAN_RADIUS,
             deadline: None,
+            cut: false,
             moves: 0,
             lk_touched: Vec::new(),
         }
@@ -101,6 +105,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 if let Some(d) = self.deadline {
                     if Instant::now() >= d {
                         self.clear();
+                        self.cut = true;
                         break;
                     }
                 }
@@ -160,7 +165,11 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         }
         let pv = tour.pos[v as usize] as usize;
         let window = if net.has_prec { SWAP_WINDOW } else { n };
-        let prune = !net.multi_mode && net.p.cost_model().is_symmetric();
+        // Positive-gain pruning: with modes only when they are a task's orientations (a swap
+        // keeps them; measured faster at equal quality on rural-postman instances), not when
+        // they are alternative places (GTSP clusters, where it cost quality).
+        let prune = (!net.multi_mode || (net.reversal_symmetric && !net.modes_self_reverse))
+            && net.p.cost_model().is_symmetric();
         // Forward: h = pv - 1, L starts at v, the new arc h -> i+1 goes to a neighbour of seq[h].
         if pv >= 1 {
             let h = pv - 1;
@@ -635,29 +644,37 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         };
         // With one mode per task and symmetric costs, a new arc at least as long as the removal
         // gain cannot pay off (positive-gain criterion); neighbour lists are sorted, so stop.
-        let prune = !net.multi_mode && net.p.cost_model().is_symmetric();
-        let too_long = |a: u32, b: u32| prune && tour.arc(net, a, b) >= gain;
-        for &c in self.nb.inn(s) {
-            if too_long(c, s) {
+        // With several modes (when they are a task's orientations) the lists' lower bounds
+        // (cheapest over mode pairs) stand in for the arc, and a single task's cheapest mode cost
+        // joins it (its mode may change).
+        let prune = (!net.multi_mode || (net.reversal_symmetric && !net.modes_self_reverse))
+            && net.p.cost_model().is_symmetric();
+        let slack = if net.multi_mode && i == j { net.min_mode_cost(s) } else { 0.0 };
+        let too_long = |a: u32, b: u32, lb: Cost| {
+            prune && if net.multi_mode { lb + slack >= gain } else { tour.arc(net, a, b) >= gain }
+        };
+        let nb = self.nb;
+        for (&c, &lb) in nb.inn(s).iter().zip(nb.inn_lb(s)) {
+            if too_long(c, s, lb) {
                 break;
             }
             consider(tour.pos[c as usize] as usize, false); // c -> s
         }
-        for &c in self.nb.out(e) {
-            if too_long(e, c) {
+        for (&c, &lb) in nb.out(e).iter().zip(nb.out_lb(e)) {
+            if too_long(e, c, lb) {
                 break;
             }
             consider(before(c), false); // e -> c
         }
         if rev_ok {
-            for &c in self.nb.inn(e) {
-                if too_long(c, e) {
+            for (&c, &lb) in nb.inn(e).iter().zip(nb.inn_lb(e)) {
+                if too_long(c, e, lb) {
                     break;
                 }
                 consider(tour.pos[c as usize] as usize, true); // c -> e
             }
-            for &c in self.nb.out(s) {
-                if too_long(s, c) {
+            for (&c, &lb) in nb.out(s).iter().zip(nb.out_lb(s)) {
+                if too_long(s, c, lb) {
                     break;
                 }
                 consider(before(c), true); // s -> c

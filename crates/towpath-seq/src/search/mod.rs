@@ -157,7 +157,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         // limit, to about a twentieth of it (an arc evaluation taken as ~5 ns).
         let mut pool_size = ((2e7 / work.max(1.0)) as usize).clamp(1, 64);
         if let Some(tl) = opts.time_limit {
-            let affordable = tl.as_secs_f64() * 0.05 / (work.max(1.0) * 5e-9);
+            let affordable = tl.as_secs_f64() * 0.25 / (work.max(1.0) * 5e-9);
             pool_size = pool_size.min(affordable as usize).max(1);
         }
         let pool = if net.depot != u32::MAX && problem.start().is_some() {
@@ -216,23 +216,30 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
     };
     let slice =
         opts.time_limit.map(|d| (d / epochs_planned as u32).clamp(Duration::from_millis(50), Duration::from_secs(2)));
+    // The search stops a little early to leave time for a last full pass of the local search
+    // (don't-look bits leave a few improving moves behind on large instances).
+    let search_end = deadline.map(|d| {
+        let reserve =
+            opts.time_limit.map_or(Duration::ZERO, |tl| (tl / 10).min(Duration::from_secs_f64(net.n as f64 * 10e-6)));
+        d - reserve
+    });
     let mut chains: Vec<ils::Chain> = (0..threads)
         .map(|t| ils::Chain::new(&best, opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ t as u64))
         .collect();
     while iterations < total_kicks {
-        if deadline.is_some_and(|d| Instant::now() >= d) {
+        if search_end.is_some_and(|d| Instant::now() >= d) {
             break;
         }
         if opts.cancel.as_ref().is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
             break;
         }
-        let epoch_deadline = match (deadline, slice) {
+        let epoch_deadline = match (search_end, slice) {
             (Some(d), Some(s)) => Some(d.min(Instant::now() + s)),
             _ => None,
         };
         let left = total_kicks - iterations;
         let kicks_each = per_epoch.min(left.div_ceil(threads as u64));
-        let budget = Budget { kicks: kicks_each, deadline: epoch_deadline };
+        let budget = Budget { kicks: kicks_each, deadline: epoch_deadline, hard: search_end };
         let cancel = opts.cancel.as_deref();
         let done: u64 = if threads == 1 {
             ils.run(&mut chains[0], budget, cancel)
@@ -272,6 +279,9 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
             break;
         }
     }
+    if !opts.cancel.as_ref().is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+        ils.descend(&mut best, deadline);
+    }
     optimize_final(&net, &mut best, eps);
     let steps = steps_from_tour(&net, &best);
     let cost = check(problem, &steps).map_err(SolveError::NoFeasibleRoute)?;
@@ -286,7 +296,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
 
 /// True when the time limit is too short to spend on descending from several starts.
 fn pool_is_short(opts: &SolveOptions, work: f64) -> bool {
-    opts.time_limit.is_some_and(|tl| tl.as_secs_f64() * 0.05 < 3.0 * work * 5e-9 * 4.0)
+    opts.time_limit.is_some_and(|tl| tl.as_secs_f64() * 0.25 < 3.0 * work * 5e-9 * 4.0)
 }
 
 fn optimize_final<C: CostModel>(net: &Net<C>, tour: &mut Tour, eps: Cost) {

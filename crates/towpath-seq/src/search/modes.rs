@@ -9,6 +9,16 @@ use crate::cost::{Cost, CostModel};
 /// Re-selects every node's mode optimally for the current order. Returns true if the cost fell
 /// by more than `eps` (the tour is then updated; otherwise it is left as it was).
 pub(crate) fn optimize_modes<C: CostModel>(net: &Net<C>, tour: &mut Tour, eps: Cost) -> bool {
+    optimize_modes_noting(net, tour, eps, &mut Vec::new())
+}
+
+/// [`optimize_modes`], and the nodes whose mode changed are appended to `changed`.
+pub(crate) fn optimize_modes_noting<C: CostModel>(
+    net: &Net<C>,
+    tour: &mut Tour,
+    eps: Cost,
+    changed: &mut Vec<u32>,
+) -> bool {
     let n = tour.len();
     if !net.multi_mode || n < 2 {
         return false;
@@ -54,7 +64,10 @@ pub(crate) fn optimize_modes<C: CostModel>(net: &Net<C>, tour: &mut Tour, eps: C
     if best_total < tour.cost - eps {
         for (i, &m) in best_modes.iter().enumerate() {
             let v = tour.seq[i];
-            tour.set_mode(v, m);
+            if tour.mode[v as usize] != m {
+                changed.push(v);
+                tour.set_mode(v, m);
+            }
         }
         tour.cost = best_total;
         true

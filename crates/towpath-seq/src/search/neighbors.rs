@@ -14,6 +14,10 @@ pub(crate) struct Neighbors {
     out_len: Vec<u8>,
     inn: Vec<u32>,
     inn_len: Vec<u8>,
+    /// The cheapest transition over all mode pairs, per entry of `out` / `inn` (a lower bound
+    /// of the arc whatever the modes; lists are sorted by it).
+    out_lb: Vec<Cost>,
+    inn_lb: Vec<Cost>,
     symmetric: bool,
 }
 
@@ -28,6 +32,25 @@ impl Neighbors {
             }
             None => &[],
         }
+    }
+
+    /// Lower bounds (cheapest over mode pairs) of the arcs to [`Neighbors::out`]'s tasks.
+    #[inline]
+    pub fn out_lb(&self, v: u32) -> &[Cost] {
+        let l = self.out(v).len();
+        let a = v as usize * self.k;
+        &self.out_lb[a..a + l]
+    }
+
+    /// Lower bounds (cheapest over mode pairs) of the arcs from [`Neighbors::inn`]'s tasks.
+    #[inline]
+    pub fn inn_lb(&self, v: u32) -> &[Cost] {
+        if self.symmetric {
+            return self.out_lb(v);
+        }
+        let l = self.inn(v).len();
+        let a = v as usize * self.k;
+        &self.inn_lb[a..a + l]
     }
 
     /// Tasks cheapest to come from into `v` (best first).
@@ -56,6 +79,8 @@ impl Neighbors {
         };
         let mut out = vec![u32::MAX; n * k];
         let mut inn = if symmetric { Vec::new() } else { vec![u32::MAX; n * k] };
+        let mut out_lb = vec![Cost::INFINITY; n * k];
+        let mut inn_lb = if symmetric { Vec::new() } else { vec![Cost::INFINITY; n * k] };
         let mut scored: Vec<(Cost, u32)> = Vec::with_capacity(n);
         for v in 0..n as u32 {
             // out
@@ -69,18 +94,20 @@ impl Neighbors {
             for &u in &pool {
                 scored.push((min_arc(net, v, u), u));
             }
-            fill(&mut out[v as usize * k..(v as usize + 1) * k], &mut scored);
+            let r = v as usize * k..(v as usize + 1) * k;
+            fill(&mut out[r.clone()], &mut out_lb[r], &mut scored);
             if !symmetric {
                 scored.clear();
                 for &u in &pool {
                     scored.push((min_arc(net, u, v), u));
                 }
-                fill(&mut inn[v as usize * k..(v as usize + 1) * k], &mut scored);
+                let r = v as usize * k..(v as usize + 1) * k;
+                fill(&mut inn[r.clone()], &mut inn_lb[r], &mut scored);
             }
         }
         let out_len = (0..n).map(|v| count(&out[v * k..(v + 1) * k])).collect();
         let inn_len = if symmetric { Vec::new() } else { (0..n).map(|v| count(&inn[v * k..(v + 1) * k])).collect() };
-        Neighbors { k, out, out_len, inn, inn_len, symmetric }
+        Neighbors { k, out, out_len, inn, inn_len, out_lb, inn_lb, symmetric }
     }
 }
 
@@ -88,7 +115,7 @@ fn count(s: &[u32]) -> u8 {
     s.iter().position(|&x| x == u32::MAX).unwrap_or(s.len()) as u8
 }
 
-fn fill(dst: &mut [u32], scored: &mut [(Cost, u32)]) {
+fn fill(dst: &mut [u32], lb: &mut [Cost], scored: &mut [(Cost, u32)]) {
     let k = dst.len().min(scored.len());
     if k == 0 {
         return;
@@ -98,8 +125,9 @@ fn fill(dst: &mut [u32], scored: &mut [(Cost, u32)]) {
     }
     let best = &mut scored[..k];
     best.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-    for (d, s) in dst.iter_mut().zip(best.iter()) {
+    for ((d, l), s) in dst.iter_mut().zip(lb.iter_mut()).zip(best.iter()) {
         *d = s.1;
+        *l = s.0;
     }
 }
 

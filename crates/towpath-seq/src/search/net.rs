@@ -181,6 +181,11 @@ impl<'p, C: CostModel> Net<'p, C> {
         }
     }
 
+    /// The cheapest internal cost of node `v` over its modes.
+    pub fn min_mode_cost(&self, v: u32) -> Cost {
+        (0..self.num_modes(v)).map(|m| self.mode_cost(v, m)).fold(Cost::INFINITY, Cost::min)
+    }
+
     /// Internal cost of a node in a mode.
     #[inline]
     pub fn mode_cost(&self, v: u32, m: u32) -> Cost {

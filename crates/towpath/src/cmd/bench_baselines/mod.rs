@@ -32,7 +32,7 @@ pub struct Args {
     #[arg(long, default_value_t = 3)]
     pub runs: u64,
     /// towpath's time limits on the seed-004 instances, milliseconds (one column each).
-    #[arg(long, value_delimiter = ',', default_values_t = [2.0, 20.0])]
+    #[arg(long, value_delimiter = ',', default_values_t = [0.8, 2.0, 20.0])]
     pub towpath_ms: Vec<f64>,
     /// A long towpath run per seed-004 instance as a reference (best known), milliseconds; 0 skips it.
     #[arg(long, default_value_t = 500.0)]
