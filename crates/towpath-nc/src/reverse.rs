@@ -92,6 +92,11 @@ fn reverse_span(
         if a.set_position {
             return Err(format!("line {} sets positions inside the course", j + 1));
         }
+        if a.events && part != Part::On {
+            // Outside the on-part block such a code changes nothing (the roller is already
+            // lifted, no tow is on); swapped, it would.
+            return Err(format!("line {} has tow or contact codes outside the on-part block", j + 1));
+        }
         let lexed = a.lexed.clone().unwrap_or_default();
         if let Some(rapid) = a.motion {
             if a.arc {

@@ -693,7 +693,9 @@ fn twin_courses_are_told_apart_by_their_retract() {
 /// precedence may be left unchecked (there is no width). `look-alike-courses.nc` has several
 /// courses that lay nothing at the same point with different approach and retract moves: the
 /// verifier's greedy matching needs an augmenting path there; `repeated-contact-code.nc` has
-/// a lift written twice on one line, which the reversal must swap twice.
+/// a lift written twice on one line, which the reversal must swap twice;
+/// `set-position-before-a-reversed-course.nc` a `G92` after a transit;
+/// `no-op-lift-in-the-approach.nc` a lift code outside the on-part block.
 #[test]
 fn fuzz_regressions_verify() {
     let mut c = Axis::new("C", AxisKind::Continuous);
@@ -752,5 +754,23 @@ fn set_position_lines_before_a_reversed_course() {
     let v = verify(&text, &out, &m, &d, &vopts()).unwrap_or_else(|e| panic!("{e}\n{out}"));
     assert_eq!(v.order, order);
     let o = optimize(&text, &m, &d, &opts(true)).unwrap();
+    verify(&text, &o.text, &m, &d, &vopts()).unwrap();
+}
+
+/// A lift code where the roller is already lifted (in an approach block) changes nothing;
+/// swapped for a reversal it would put the roller down. Such a course is laid forward only,
+/// and the report says why. Found by the fuzz target.
+#[test]
+fn contact_codes_outside_the_on_part_block_keep_a_course_forward() {
+    let d = Dialect::default();
+    let m = gantry();
+    let text = program().replacen("G1 Z0 F1000\nM20\n", "G1 Z0 F1000\nM21 (make sure)\nM20\n", 1);
+    assert_ne!(text, program());
+    let p = parse(&text, &m, &d).unwrap();
+    let e = towpath_nc::reverse_course(&p, 0, &m, &d).unwrap_err();
+    assert!(e.contains("outside the on-part block"), "{e}");
+    let o = optimize(&text, &m, &d, &opts(true)).unwrap();
+    assert_eq!(o.afp.not_reversible.iter().map(|x| x.0).collect::<Vec<_>>(), vec![0]);
+    assert!(o.order.iter().any(|pl| pl.course == 0 && !pl.reversed));
     verify(&text, &o.text, &m, &d, &vopts()).unwrap();
 }
