@@ -1,11 +1,11 @@
 //! Fuzzes the AFP program parser: any text is either refused with an error or parsed into a
-//! program that writes back byte for byte, whose courses can be reversed or refused, never a
-//! panic.
+//! program that writes back byte for byte, whose courses can be reversed or refused, and whose
+//! rewrite in reverse order (reversing what can be) verifies against it; never a panic.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use towpath_machine::{Axis, AxisKind, Machine};
-use towpath_nc::{parse, reverse_course, rewrite, Dialect, Placement};
+use towpath_nc::{parse, reverse_course, rewrite, verify, Dialect, Placement, VerifyError, VerifyOptions};
 
 fuzz_target!(|data: &[u8]| {
     let text = String::from_utf8_lossy(data);
@@ -27,6 +27,13 @@ fuzz_target!(|data: &[u8]| {
         let reversed: Vec<_> = (0..p.courses.len()).map(|c| reverse_course(&p, c, &machine, &dialect).ok()).collect();
         let order: Vec<Placement> =
             (0..p.courses.len()).rev().map(|c| Placement { course: c, reversed: reversed[c].is_some() }).collect();
-        let _ = rewrite(&p, &order, &machine, &dialect, &reversed);
+        // Any order writes a program the verifier reads back as the same courses, each forward
+        // or legally reversed, with every kept line: only precedence may fail (no width here).
+        if let Ok(out) = rewrite(&p, &order, &machine, &dialect, &reversed) {
+            match verify(&text, &out, &machine, &dialect, &VerifyOptions::default()) {
+                Ok(_) | Err(VerifyError::Setup(_) | VerifyError::Precedence { .. } | VerifyError::Order(_)) => {}
+                Err(e) => panic!("the rewritten program does not verify: {e}\n{out}"),
+            }
+        }
     }
 });

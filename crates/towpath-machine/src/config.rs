@@ -403,6 +403,53 @@ heading = true
         assert!(e.to_string().contains("max_velocity"), "{e}");
     }
 
+    /// Every key a machine file can hold, collected from a machine that sets them all.
+    fn keys(value: &toml::Value, out: &mut Vec<String>) {
+        match value {
+            toml::Value::Table(t) => {
+                for (k, v) in t {
+                    out.push(k.clone());
+                    keys(v, out);
+                }
+            }
+            toml::Value::Array(a) => a.iter().for_each(|v| keys(v, out)),
+            _ => {}
+        }
+    }
+
+    /// "document every key": each key the machine file accepts has a row in docs/machine.md,
+    /// and the example at the top of that page is a valid machine.
+    #[test]
+    fn every_key_is_documented() {
+        let docs = include_str!("../../../docs/machine.md");
+        let mut full = Machine::from_toml_str(GANTRY).unwrap();
+        full.axes[0].min = Some(-10.0);
+        full.axes[0].max = Some(10.0);
+        full.axes[0].home = 1.0;
+        let mut mandrel = Axis::new("A", AxisKind::Mandrel);
+        mandrel.direction = Some([1.0, 0.0, 0.0]);
+        mandrel.origin = Some([0.0, 0.0, 1.0]);
+        full.axes.push(mandrel);
+        full.dh = vec![DhJoint { a: 1.0, d: 1.0, alpha: 1.0, theta: 1.0, axis: Some("X".into()) }];
+        full.tool_offset = Some([0.0, 0.0, 1.0]);
+        full.validate().unwrap();
+        let value: toml::Value = toml::from_str(&full.to_toml_string()).unwrap();
+        let mut all = Vec::new();
+        keys(&value, &mut all);
+        all.sort();
+        all.dedup();
+        assert!(all.len() >= 18, "{all:?}");
+        for k in &all {
+            let table = k == "axis" || k == "dh";
+            let documented =
+                if table { docs.contains(&format!("`[[{k}]]`")) } else { docs.contains(&format!("`{k}`")) };
+            assert!(documented, "key {k} is not documented in docs/machine.md");
+        }
+        let example = docs.split("```toml\n").nth(1).and_then(|s| s.split("```").next()).unwrap();
+        let m = Machine::from_toml_str(example).unwrap();
+        assert_eq!(m.heading_axis(), m.axis_index("C"));
+    }
+
     #[test]
     fn short_way_round() {
         assert_eq!(wrap_degrees(350.0), -10.0);

@@ -67,6 +67,13 @@ pub struct Dialect {
     pub rapid: Vec<String>,
     /// Codes of feed (linear interpolation) moves.
     pub feed: Vec<String>,
+    /// Codes of clockwise arcs (centre by `I`/`J`/`K` offsets from the start, or radius `R`).
+    /// Arcs are kept only inside on-part blocks, as they are; empty: arcs are refused.
+    pub arc_cw: Vec<String>,
+    /// Codes of counter-clockwise arcs.
+    pub arc_ccw: Vec<String>,
+    /// Plane selection codes for arcs, in the order XY, ZX, YZ (modal; XY at the start).
+    pub arc_planes: Vec<String>,
     /// Absolute distance mode.
     pub absolute: String,
     /// Incremental distance mode.
@@ -123,6 +130,9 @@ impl Default for Dialect {
         Dialect {
             rapid: vec![s("G0")],
             feed: vec![s("G1")],
+            arc_cw: vec![s("G2")],
+            arc_ccw: vec![s("G3")],
+            arc_planes: vec![s("G17"), s("G18"), s("G19")],
             absolute: s("G90"),
             incremental: s("G91"),
             set_position: s("G92"),
@@ -154,6 +164,9 @@ impl Default for Dialect {
 pub(crate) struct Codes {
     pub rapid: Vec<Code>,
     pub feed: Vec<Code>,
+    pub arc_cw: Vec<Code>,
+    pub arc_ccw: Vec<Code>,
+    pub planes: Vec<Code>,
     pub absolute: Code,
     pub incremental: Code,
     pub set_position: Code,
@@ -222,9 +235,20 @@ impl Dialect {
         if self.ply_comment.trim().is_empty() {
             return Err(NcError::Dialect("ply_comment: must not be empty".into()));
         }
+        let any = |key: &str, v: &[String]| -> Result<Vec<Code>, NcError> { v.iter().map(|x| code(key, x)).collect() };
+        let planes = any("arc_planes", &self.arc_planes)?;
+        if planes.len() != 3 {
+            return Err(NcError::Dialect(format!(
+                "arc_planes: give three codes (planes XY, ZX and YZ), not {}",
+                planes.len()
+            )));
+        }
         Ok(Codes {
             rapid: list("rapid", &self.rapid)?,
             feed: list("feed", &self.feed)?,
+            arc_cw: any("arc_cw", &self.arc_cw)?,
+            arc_ccw: any("arc_ccw", &self.arc_ccw)?,
+            planes,
             absolute: code("absolute", &self.absolute)?,
             incremental: code("incremental", &self.incremental)?,
             set_position: code("set_position", &self.set_position)?,
@@ -258,6 +282,34 @@ mod tests {
         assert!(Code::parse("g64.1").unwrap().matches('G', 64.1));
         assert!(Code::parse("X").is_none());
         assert!(Code::parse("1G").is_none());
+    }
+
+    /// Every key of a dialect file has a row in docs/dialect.md, with its default.
+    #[test]
+    fn every_key_is_documented_with_its_default() {
+        let docs = include_str!("../../../docs/dialect.md");
+        let d = Dialect { tow_width: Some(1.0), course_width: Some(1.0), ..Dialect::default() };
+        let toml::Value::Table(t) = toml::from_str::<toml::Value>(&d.to_toml_string()).unwrap() else {
+            panic!("a dialect is a table")
+        };
+        let reference: toml::Value = toml::from_str(&Dialect::default().to_toml_string()).unwrap();
+        assert!(t.len() >= 24, "{t:?}");
+        for k in t.keys() {
+            let row = docs.lines().find(|l| l.starts_with(&format!("| `{k}` |")));
+            let Some(row) = row else { panic!("key {k} is not documented in docs/dialect.md") };
+            // The default column shows the reference value.
+            let default = row.split('|').nth(2).unwrap_or("").trim().trim_matches('`').to_string();
+            match reference.get(k) {
+                Some(v) => {
+                    let shown = match v {
+                        toml::Value::String(s) => format!("\"{s}\""),
+                        other => other.to_string().replace(", ", ","),
+                    };
+                    assert_eq!(default.replace(", ", ","), shown, "default of {k}");
+                }
+                None => assert_eq!(default, "none", "default of {k}"),
+            }
+        }
     }
 
     #[test]

@@ -15,6 +15,21 @@ use crate::lex::{lex, Lexed, NumText, Word};
 /// Largest axis value accepted, in mm or degrees.
 pub const MAX_AXIS_VALUE: f64 = 1e7;
 
+/// Words of an arc: centre offsets from the start (I along X, J along Y, K along Z) or radius.
+const ARC_WORDS: &str = "IJKR";
+
+/// Plane axes of arcs (in the order of the plane codes: XY, ZX, YZ), with the centre-offset
+/// letters of each axis.
+const PLANES: [([char; 2], [char; 2]); 3] =
+    [(['X', 'Y'], ['I', 'J']), (['Z', 'X'], ['K', 'I']), (['Y', 'Z'], ['J', 'K'])];
+
+/// How far (mm) an arc's end may be off its circle, as controllers allow.
+pub const ARC_RADIUS_TOLERANCE: f64 = 0.01;
+
+/// Largest distance (mm) between an arc and the chords towpath replaces it by for footprints
+/// and costs.
+pub const ARC_CHORD_TOLERANCE: f64 = 0.002;
+
 /// Letters that address axes in ISO programs; one of these on a motion line that the machine
 /// does not have is an unknown axis.
 const AXIS_LETTERS: &str = "XYZABCUVW";
@@ -30,8 +45,13 @@ pub struct Modal {
     pub phys: Vec<f64>,
     /// Incremental distance mode.
     pub incremental: bool,
-    /// Modal motion: `Some(true)` rapid, `Some(false)` feed, `None` not yet set.
+    /// Modal motion: `Some(true)` rapid, `Some(false)` feed (linear or arc), `None` not yet set.
     pub rapid: Option<bool>,
+    /// Modal arc mode: `Some(true)` clockwise, `Some(false)` counter-clockwise, `None` when the
+    /// motion mode is not an arc.
+    pub arc: Option<bool>,
+    /// Modal arc plane: 0 XY, 1 ZX, 2 YZ.
+    pub plane: u8,
     /// Modal feed value and its text.
     pub feed: Option<(f64, NumText)>,
     /// Roller in contact.
@@ -50,6 +70,8 @@ impl Modal {
             phys: h,
             incremental: false,
             rapid: None,
+            arc: None,
+            plane: 0,
             feed: None,
             contact: false,
             mask: 0,
@@ -85,8 +107,13 @@ pub enum Marker {
 pub struct Applied {
     /// The lexed line (`None` if it could not be lexed; it is then kept as it is).
     pub lexed: Option<Lexed>,
-    /// The line moved the axes: true for rapid, false for feed.
+    /// The line moved the axes: true for rapid, false for feed (linear or arc).
     pub motion: Option<bool>,
+    /// The move is an arc.
+    pub arc: bool,
+    /// Physical states the move passes through before its end point: an arc's tessellation
+    /// (empty for a straight move).
+    pub path: Vec<Vec<f64>>,
     /// Events before the move (or the line's only events if it does not move).
     pub before: Vec<Event>,
     /// Events after the move.
@@ -200,7 +227,10 @@ impl<'a> Interp<'a> {
         let mut out = Applied { marker: self.marker(&lexed.comments), ..Applied::default() };
 
         let c = &self.codes;
-        let mut motion_code: Option<bool> = None;
+        // 0 rapid, 1 feed, 2 clockwise arc, 3 counter-clockwise arc.
+        let mut motion_code: Option<u8> = None;
+        let mut plane: Option<u8> = None;
+        let mut arc_words: Vec<&Word> = Vec::new();
         let mut distance: Option<bool> = None;
         let mut set_pos = false;
         let mut feed: Option<&Word> = None;
@@ -216,9 +246,15 @@ impl<'a> Interp<'a> {
             let l = w.letter;
             if l == 'G' {
                 if c.rapid.iter().any(|k| k.matches(l, w.value)) {
-                    set_once(&mut motion_code, true, n, "two motion codes")?;
+                    set_once(&mut motion_code, 0, n, "two motion codes")?;
                 } else if c.feed.iter().any(|k| k.matches(l, w.value)) {
-                    set_once(&mut motion_code, false, n, "two motion codes")?;
+                    set_once(&mut motion_code, 1, n, "two motion codes")?;
+                } else if c.arc_cw.iter().any(|k| k.matches(l, w.value)) {
+                    set_once(&mut motion_code, 2, n, "two motion codes")?;
+                } else if c.arc_ccw.iter().any(|k| k.matches(l, w.value)) {
+                    set_once(&mut motion_code, 3, n, "two motion codes")?;
+                } else if let Some(k) = c.planes.iter().position(|k| k.matches(l, w.value)) {
+                    set_once(&mut plane, k as u8, n, "two arc planes")?;
                 } else if c.absolute.matches(l, w.value) {
                     set_once(&mut distance, false, n, "two distance modes")?;
                 } else if c.incremental.matches(l, w.value) {
@@ -254,6 +290,11 @@ impl<'a> Interp<'a> {
                 axes.push((i, w));
             } else if l == c.mask_word && (restart || cut || lexed.words.iter().any(|x| is_tow(c, x))) {
                 mask = Some(w);
+            } else if ARC_WORDS.contains(l) {
+                if arc_words.iter().any(|x| x.letter == l) {
+                    return Err(NcError::line(n, format!("{l} is written twice")));
+                }
+                arc_words.push(w);
             } else {
                 if AXIS_LETTERS.contains(l) && !passthrough && !lexed.words.iter().any(|x| self.is_non_motion(x)) {
                     return Err(NcError::line(
@@ -278,8 +319,27 @@ impl<'a> Interp<'a> {
             if set_pos {
                 return Err(NcError::line(n, "a set-position code and a motion code on one line"));
             }
-            self.m.rapid = Some(r);
+            self.m.rapid = Some(r == 0);
+            self.m.arc = match r {
+                2 => Some(true),
+                3 => Some(false),
+                _ => None,
+            };
             out.modal = true;
+        }
+        if let Some(p) = plane {
+            self.m.plane = p;
+            out.modal = true;
+        }
+        // An arc: axis words in arc mode, or centre words alone (a full circle where it stands).
+        let arc_move = self.m.arc.is_some()
+            && (!axes.is_empty() || !arc_words.is_empty())
+            && !set_pos
+            && !passthrough
+            && other_g.is_none();
+        if !arc_move && !arc_words.is_empty() {
+            // Centre or radius words on a line that is no arc: words towpath does not know.
+            out.unknown = true;
         }
         if let Some(f) = feed {
             if f.value <= 0.0 || f.value.is_nan() {
@@ -335,7 +395,7 @@ impl<'a> Interp<'a> {
         } else if !axes.is_empty() && passthrough {
             // A dwell or similar: the words are not positions.
             out.unknown = true;
-        } else if !axes.is_empty() {
+        } else if !axes.is_empty() || arc_move {
             if let Some(g) = other_g {
                 return Err(NcError::line(
                     n,
@@ -352,6 +412,18 @@ impl<'a> Interp<'a> {
             if timing == EventTiming::Before {
                 self.events(n, &events)?;
                 out.before = events.clone();
+            }
+            // The state where an arc starts (straight moves need none).
+            let start = if arc_move { Some((self.m.prog.clone(), self.m.phys.clone())) } else { None };
+            if arc_move {
+                let laying = if self.codes.contact.is_some() { self.m.contact } else { self.m.mask != 0 };
+                if !laying {
+                    return Err(NcError::line(
+                        n,
+                        "an arc outside a course's on-part block: towpath keeps arcs only where material is laid \
+                         (off-part motion is regenerated with straight moves)",
+                    ));
+                }
             }
             for (i, w) in &axes {
                 let (target, text) =
@@ -373,6 +445,10 @@ impl<'a> Interp<'a> {
                 }
             }
             out.motion = Some(rapid);
+            if let (Some(cw), Some((prog, phys))) = (self.m.arc, &start) {
+                out.arc = true;
+                out.path = self.arc_path(n, prog, phys, cw, &arc_words)?;
+            }
             if timing == EventTiming::After {
                 self.events(n, &events)?;
                 out.after = events;
@@ -384,6 +460,103 @@ impl<'a> Interp<'a> {
         out.before = events;
         out.lexed = Some(lexed);
         Ok(out)
+    }
+
+    /// The physical states an arc from `start` to the current state passes through (its end
+    /// excluded), every chord within [`ARC_CHORD_TOLERANCE`] of the arc.
+    fn arc_path(
+        &self,
+        n: usize,
+        start_prog: &[f64],
+        start_phys: &[f64],
+        cw: bool,
+        words: &[&Word],
+    ) -> Result<Vec<Vec<f64>>, NcError> {
+        let (labels, centre) = PLANES[self.m.plane as usize % 3];
+        let plane_name: String = labels.iter().collect();
+        let mut idx = [0usize; 2];
+        for k in 0..2 {
+            match self.axis_of(labels[k]) {
+                Some(i) if self.kinds[i] == AxisKind::Linear => idx[k] = i,
+                _ => {
+                    return Err(NcError::line(
+                        n,
+                        format!("an arc in the {plane_name} plane needs linear axes {} and {}", labels[0], labels[1]),
+                    ))
+                }
+            }
+        }
+        let word = |l: char| words.iter().find(|w| w.letter == l).map(|w| w.value);
+        let (s, e) = ([start_prog[idx[0]], start_prog[idx[1]]], [self.m.prog[idx[0]], self.m.prog[idx[1]]]);
+        let chord = ((e[0] - s[0]).powi(2) + (e[1] - s[1]).powi(2)).sqrt();
+        let offsets = [word(centre[0]), word(centre[1])];
+        let c = match (word('R'), offsets) {
+            (Some(_), [Some(_), _] | [_, Some(_)]) => {
+                return Err(NcError::line(n, "an arc with both a radius R and centre offsets"));
+            }
+            (Some(r), _) => {
+                if chord <= 1e-9 {
+                    return Err(NcError::line(n, "an arc given by its radius R must end away from its start"));
+                }
+                let h2 = r * r - chord * chord / 4.0;
+                if h2 < -(ARC_RADIUS_TOLERANCE * chord) {
+                    return Err(NcError::line(
+                        n,
+                        format!(
+                            "the arc's radius R{r} is shorter than half the distance to its end ({:.4})",
+                            chord / 2.0
+                        ),
+                    ));
+                }
+                let h = h2.max(0.0).sqrt();
+                let u = [(e[0] - s[0]) / chord, (e[1] - s[1]) / chord];
+                // Clockwise arcs of at most half a turn have their centre right of the chord.
+                let side = if cw == (r > 0.0) { 1.0 } else { -1.0 };
+                [(s[0] + e[0]) / 2.0 + side * h * u[1], (s[1] + e[1]) / 2.0 - side * h * u[0]]
+            }
+            (None, [None, None]) => {
+                return Err(NcError::line(
+                    n,
+                    format!("an arc needs its centre ({}, {}) or its radius R", centre[0], centre[1]),
+                ));
+            }
+            (None, [i, j]) => [s[0] + i.unwrap_or(0.0), s[1] + j.unwrap_or(0.0)],
+        };
+        let r0 = ((s[0] - c[0]).powi(2) + (s[1] - c[1]).powi(2)).sqrt();
+        let r1 = ((e[0] - c[0]).powi(2) + (e[1] - c[1]).powi(2)).sqrt();
+        if r0 <= 1e-9 {
+            return Err(NcError::line(n, "an arc of zero radius"));
+        }
+        if (r0 - r1).abs() > ARC_RADIUS_TOLERANCE {
+            return Err(NcError::line(
+                n,
+                format!("the arc's end is not on its circle: radius {r0:.4} at the start, {r1:.4} at the end"),
+            ));
+        }
+        let a0 = (s[1] - c[1]).atan2(s[0] - c[0]);
+        let a1 = (e[1] - c[1]).atan2(e[0] - c[0]);
+        let tau = std::f64::consts::TAU;
+        let mut sweep = if cw { (a0 - a1).rem_euclid(tau) } else { (a1 - a0).rem_euclid(tau) };
+        if chord <= 1e-9 {
+            sweep = tau;
+        }
+        let r = r0.max(r1);
+        let step = if r > ARC_CHORD_TOLERANCE { 2.0 * (1.0 - ARC_CHORD_TOLERANCE / r).acos() } else { tau / 4.0 };
+        let pieces = ((sweep / step).ceil() as usize).clamp(1, 4096);
+        let dir = if cw { -1.0 } else { 1.0 };
+        let mut path = Vec::with_capacity(pieces.saturating_sub(1));
+        for k in 1..pieces {
+            let t = k as f64 / pieces as f64;
+            let a = a0 + dir * sweep * t;
+            let rt = r0 + (r1 - r0) * t;
+            let mut p: Vec<f64> = start_phys.iter().zip(&self.m.phys).map(|(x, y)| x + (y - x) * t).collect();
+            for (k2, v) in [c[0] + rt * a.cos(), c[1] + rt * a.sin()].into_iter().enumerate() {
+                let i = idx[k2];
+                p[i] = v + (start_phys[i] - start_prog[i]);
+            }
+            path.push(p);
+        }
+        Ok(path)
     }
 
     fn is_non_motion(&self, w: &Word) -> bool {
@@ -565,10 +738,11 @@ mod tests {
         let mut it = Interp::new(&d, &m).unwrap();
         assert!(it.apply(0, "X10").unwrap_err().to_string().contains("no motion mode"));
         assert!(it.apply(1, "G0 Z10").unwrap_err().to_string().starts_with("line 2: unknown axis Z"));
-        assert!(it.apply(2, "G2 X10").unwrap_err().to_string().contains("G2 with axis words"));
+        assert!(it.apply(2, "G5 X10").unwrap_err().to_string().contains("G5 with axis words"));
         assert!(it.apply(3, "G0 X#1").is_err());
         assert!(it.apply(4, "G0 X99999999").unwrap_err().to_string().contains("range"));
         assert!(it.apply(5, "G1 X3").unwrap_err().to_string().contains("no feed"));
+        assert!(it.apply(5, "G2 X10 I5 F100").unwrap_err().to_string().contains("outside a course's on-part block"));
         // Unknown but harmless lines are kept.
         let a = it.apply(6, "%").unwrap();
         assert!(a.unknown);
@@ -578,5 +752,47 @@ mod tests {
         assert_eq!(a.marker, Some(Marker::Ply(Some(3), "PLY 3 angle 45".into())));
         assert_eq!(it.apply(9, "(plywood)").unwrap().marker, None);
         assert_eq!(it.apply(10, "(COURSE)").unwrap().marker, Some(Marker::Course(None)));
+    }
+
+    /// In the ZX plane (G18) a clockwise arc, seen from +Y, turns from +X towards +Z.
+    #[test]
+    fn arcs_in_the_zx_plane() {
+        let d = Dialect::default();
+        let m = Machine::new(
+            "m",
+            vec![Axis::new("X", AxisKind::Linear), Axis::new("Y", AxisKind::Linear), Axis::new("Z", AxisKind::Linear)],
+        )
+        .unwrap();
+        let mut it = Interp::new(&d, &m).unwrap();
+        it.apply(0, "G0 X10 Y0 Z0").unwrap();
+        it.apply(1, "M20").unwrap();
+        it.apply(2, "M60 P1").unwrap();
+        it.apply(3, "G18").unwrap();
+        let a = it.apply(4, "G2 X0 Z10 I-10 K0 F100").unwrap();
+        assert!(a.arc && a.motion == Some(false) && !a.path.is_empty());
+        let mid = &a.path[a.path.len() / 2];
+        assert!(mid[0] > 6.0 && mid[2] > 6.0 && mid[1] == 0.0, "{mid:?}");
+        for p in &a.path {
+            assert!((p[0].hypot(p[2]) - 10.0).abs() < 1e-9);
+        }
+        // Modal: the next line without a motion code is an arc too (back the other way).
+        let b = it.apply(5, "G3 X10 Z0 I0 K-10").unwrap();
+        assert!(b.arc && b.path.iter().all(|p| p[0] > -1e-9 && p[2] > -1e-9));
+        let c = it.apply(6, "X0 Z10 I-10").unwrap();
+        assert!(c.arc);
+        // Centre words alone in arc mode: a full circle from where the tool stands.
+        let full = it.apply(7, "K-5").unwrap();
+        assert!(full.arc && full.motion == Some(false) && full.path.len() > 8);
+        assert!(full.path.iter().all(|p| (p[0].hypot(p[2] - 5.0) - 5.0).abs() < 1e-9));
+        assert_eq!(it.m.prog, vec![0.0, 0.0, 10.0]);
+        // A machine without the plane's axes cannot lay the arc.
+        it.apply(8, "G19").unwrap();
+        let m2 = Machine::new("m", vec![Axis::new("X", AxisKind::Linear), Axis::new("Y", AxisKind::Linear)]).unwrap();
+        let mut it2 = Interp::new(&d, &m2).unwrap();
+        it2.apply(0, "M20").unwrap();
+        it2.apply(1, "M60 P1").unwrap();
+        it2.apply(2, "G19").unwrap();
+        let e = it2.apply(3, "G2 Y10 J5 F100").unwrap_err();
+        assert!(e.to_string().contains("YZ plane needs linear axes Y and Z"), "{e}");
     }
 }

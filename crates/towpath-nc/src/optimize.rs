@@ -175,6 +175,7 @@ pub fn optimize(
         width: opts.afp.width_or(dialect),
         strict_plies: opts.afp.precedence == crate::problem::PrecedenceRule::Plies,
         keep_ply_order: opts.afp.keep_ply_order,
+        seed000_sets: opts.afp.precedence == crate::problem::PrecedenceRule::Sets,
     };
     let check = |text: &str| -> Result<Verification, NcError> {
         let parsed = crate::parse::parse(text, machine, dialect).map_err(|e| NcError::SelfCheck(e.to_string()))?;
@@ -230,6 +231,7 @@ pub fn apply_steps(
         width: opts.width_or(dialect),
         strict_plies: opts.precedence == crate::problem::PrecedenceRule::Plies,
         keep_ply_order: opts.keep_ply_order,
+        seed000_sets: opts.precedence == crate::problem::PrecedenceRule::Sets,
     };
     let v = verify_parsed(program, &parsed, machine, dialect, &vopts, afp.footprints.as_ref())
         .map_err(|e| NcError::SelfCheck(e.to_string()))?;

@@ -61,18 +61,21 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
         if let Some(rapid) = a.motion {
             // The state during the move: before the line's events if they come after it.
             let (contact, mask) = if timing_after { (before_contact, before_mask) } else { (it.m.contact, it.m.mask) };
-            let from = (points.len() / dim.max(1) - 1) as u32;
-            points.extend_from_slice(&it.m.phys);
-            segments.push(Segment {
-                line: i as u32,
-                from,
-                to: from + 1,
-                rapid,
-                feed: it.m.feed.as_ref().map_or(f64::NAN, |f| f.0),
-                mask,
-                on_part: in_course(contact, mask),
-            });
-            line_segment[i] = Some(segments.len() as u32 - 1);
+            // An arc is laid as its chords: one segment per piece, all on this line.
+            line_segment[i] = Some(segments.len() as u32);
+            for p in a.path.iter().map(Vec::as_slice).chain(std::iter::once(it.m.phys.as_slice())) {
+                let from = (points.len() / dim.max(1) - 1) as u32;
+                points.extend_from_slice(p);
+                segments.push(Segment {
+                    line: i as u32,
+                    from,
+                    to: from + 1,
+                    rapid,
+                    feed: it.m.feed.as_ref().map_or(f64::NAN, |f| f.0),
+                    mask,
+                    on_part: in_course(contact, mask),
+                });
+            }
         }
         // A line that both opens and closes a course would leave an empty on-part block.
         let toggles = a.events().filter(|e| matches!(e, crate::interp::Event::Contact(_))).count();

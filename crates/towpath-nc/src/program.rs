@@ -123,7 +123,8 @@ pub struct Program {
     pub points: Vec<f64>,
     /// Every move.
     pub segments: Vec<Segment>,
-    /// Segment index of each line's move, if it moves.
+    /// Index of the first segment of each line's move, if it moves (an arc has one segment per
+    /// chord, all on its line).
     pub line_segment: Vec<Option<u32>>,
     /// Lines `0..header_end` are the header.
     pub header_end: usize,

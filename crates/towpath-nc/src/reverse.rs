@@ -92,8 +92,16 @@ fn reverse_span(
         if a.set_position {
             return Err(format!("line {} sets positions inside the course", j + 1));
         }
+        if a.events && part != Part::On {
+            // Outside the on-part block such a code changes nothing (the roller is already
+            // lifted, no tow is on); swapped, it would.
+            return Err(format!("line {} has tow or contact codes outside the on-part block", j + 1));
+        }
         let lexed = a.lexed.clone().unwrap_or_default();
         if let Some(rapid) = a.motion {
+            if a.arc {
+                return Err(format!("line {} is an arc: towpath lays arcs only as they are written, forward", j + 1));
+            }
             if a.unknown {
                 return Err(format!("line {} has words towpath does not know on a move", j + 1));
             }
@@ -273,7 +281,8 @@ fn swapped_event(e: &Event, dialect: &Dialect, lexed: &Lexed) -> String {
     }
 }
 
-/// An event line with its code word swapped (restart ↔ cut, contact on ↔ off), the rest kept.
+/// An event line with its code word swapped (restart ↔ cut, contact on ↔ off; every copy of
+/// it), the rest kept.
 fn swap_line_code(line: &str, e: &Event, dialect: &Dialect, codes: &crate::dialect::Codes, lexed: &Lexed) -> String {
     let (from, to) = match *e {
         Event::Contact(on) => match &codes.contact {
@@ -294,10 +303,17 @@ fn swap_line_code(line: &str, e: &Event, dialect: &Dialect, codes: &crate::diale
             }
         }
     };
-    match lexed.words.iter().find(|w| from.matches(w.letter, w.value)) {
-        Some(w) => format!("{}{}{}", &line[..w.span.start], to, &line[w.span.end..]),
-        None => swapped_event(e, dialect, lexed),
+    // Every word of that code (a line may repeat it), from the end so the spans stay right.
+    let spans: Vec<_> =
+        lexed.words.iter().filter(|w| from.matches(w.letter, w.value)).map(|w| w.span.clone()).collect();
+    if spans.is_empty() {
+        return swapped_event(e, dialect, lexed);
     }
+    let mut out = line.to_string();
+    for span in spans.into_iter().rev() {
+        out.replace_range(span, &to);
+    }
+    out
 }
 
 /// Formats a number with at most `decimals` digits after the point, trailing zeros dropped.

@@ -122,9 +122,19 @@ pub fn rewrite(
         } else {
             None
         };
-        let target = rev.map_or(&course.insert, |r| &r.entry);
-        e.transit(target)?;
-        e.items(program, &course.pre_after)?;
+        match rev {
+            None => {
+                // The lines after the original transit run after the new one, as they did.
+                e.transit(&course.insert)?;
+                e.items(program, &course.pre_after)?;
+            }
+            Some(r) => {
+                // The reversed span needs exactly its entry state: the lines that followed the
+                // original transit (which may set positions or modes) go before the new one.
+                e.items(program, &course.pre_after)?;
+                e.transit(&r.entry)?;
+            }
+        }
         match rev {
             Some(r) => {
                 for l in &r.lines {
@@ -275,10 +285,18 @@ impl Emitter<'_> {
             modal.push(if target.incremental { d.incremental.clone() } else { d.absolute.clone() });
         }
         if let Some(r) = target.rapid {
-            if now.rapid != Some(r) {
-                let code = if r { d.rapid.first() } else { d.feed.first() };
+            if now.rapid != Some(r) || now.arc != target.arc {
+                let code = match target.arc {
+                    Some(true) => d.arc_cw.first(),
+                    Some(false) => d.arc_ccw.first(),
+                    None if r => d.rapid.first(),
+                    None => d.feed.first(),
+                };
                 modal.push(code.cloned().unwrap_or_default());
             }
+        }
+        if now.plane != target.plane {
+            modal.push(d.arc_planes.get(target.plane as usize).cloned().unwrap_or_default());
         }
         if let Some((v, t)) = &target.feed {
             if now.feed.as_ref().map(|f| f.0) != Some(*v) {

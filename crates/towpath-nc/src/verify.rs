@@ -30,6 +30,9 @@ pub struct VerifyOptions {
     pub strict_plies: bool,
     /// Also require the courses of each ply in their original order.
     pub keep_ply_order: bool,
+    /// Also require seed 000's precedence sets in order: every course of a set laid before any
+    /// course of the next (the verifier finds the sets on its own, from the footprints).
+    pub seed000_sets: bool,
 }
 
 /// Why an optimized program does not verify.
@@ -169,6 +172,10 @@ pub fn verify_parsed(
     // Precedence.
     let plies_with_courses = orig.plies.iter().filter(|p| !p.courses.is_empty()).count();
     let mut precedence_checked = false;
+    let mut pos = vec![0usize; k];
+    for (i, p) in order.iter().enumerate() {
+        pos[p.course] = i;
+    }
     if plies_with_courses > 1 {
         let width = opts.width.or(dialect.course_width.map(Width::Course)).or(dialect.tow_width.map(Width::Tow));
         let owned;
@@ -187,11 +194,10 @@ pub fn verify_parsed(
             }
         };
         check_precedence(orig, fps, &order)?;
+        if opts.seed000_sets {
+            check_sets(orig, fps, &order)?;
+        }
         precedence_checked = true;
-    }
-    let mut pos = vec![0usize; k];
-    for (i, p) in order.iter().enumerate() {
-        pos[p.course] = i;
     }
     if opts.strict_plies {
         for w in orig.plies.iter().filter(|p| !p.courses.is_empty()).collect::<Vec<_>>().windows(2) {
@@ -238,40 +244,98 @@ pub fn verify_parsed(
     })
 }
 
-/// The span of a course as points (physical values), with each move's (on-part, tows, feed).
+/// One move: (on-part, tows on, feed; NaN for a rapid move).
+type SpanMove = (bool, u64, f64);
+
+/// Consecutive moves of a program as points (physical values), with each move's (on-part,
+/// tows, feed).
 struct SpanMotion {
     points: Vec<Vec<f64>>,
-    moves: Vec<(bool, u64, f64)>,
+    moves: Vec<SpanMove>,
+    /// Off-part moves before the first laid one (the approach).
+    lead: usize,
+    /// Off-part moves after the last laid one (the retract).
+    trail: usize,
 }
 
+/// The position of program `p` just before its move `i` (after its last move if `i` is past
+/// the end), as a point index.
+fn point_before(p: &Program, i: usize) -> u32 {
+    match p.segments.get(i) {
+        Some(s) => s.from,
+        None => (p.points.len() / p.dim.max(1)).saturating_sub(1) as u32,
+    }
+}
+
+/// The moves `segs` of `p`, `lead` of them before the laying and `trail` after.
+fn motion_of(p: &Program, segs: std::ops::Range<usize>, lead: usize, trail: usize) -> SpanMotion {
+    let mut points = vec![p.point(point_before(p, segs.start)).to_vec()];
+    let mut moves = Vec::with_capacity(segs.len());
+    for s in &p.segments[segs] {
+        points.push(p.point(s.to).to_vec());
+        // A rapid move has no feed: it moves at the machine's speed, whatever the modal feed.
+        moves.push((s.on_part, s.mask, if s.rapid { f64::NAN } else { s.feed }));
+    }
+    SpanMotion { points, moves, lead, trail }
+}
+
+/// The moves of course `c` that lay material, as a range of `p.segments`: from its first laid
+/// move to its last; for a course that lays nothing, an empty range where the roller comes
+/// into contact.
+fn laying(p: &Program, c: usize) -> std::ops::Range<usize> {
+    let course = &p.courses[c];
+    let segs = course.segments.clone();
+    let first = segs.clone().find(|&i| p.segments[i].on_part);
+    let last = segs.clone().rev().find(|&i| p.segments[i].on_part);
+    if let (Some(f), Some(l)) = (first, last) {
+        return f..l + 1;
+    }
+    // Nothing laid: the place where the roller comes into contact (after a move written on that
+    // line, which comes before the contact when it is not laid). Reversed, the contact comes
+    // where the original lifted, so the moves on either side swap as the blocks do.
+    let at = segs.clone().find(|&i| p.segments[i].line as usize > course.on_part.start).unwrap_or(segs.end);
+    at..at
+}
+
+/// The moves of course `c`'s span.
 fn span_motion(p: &Program, c: usize) -> SpanMotion {
     let course = &p.courses[c];
-    let mut points = vec![course.span_start.phys.clone()];
-    let mut moves = Vec::new();
-    for s in &p.segments[course.segments.clone()] {
-        points.push(p.point(s.to).to_vec());
-        moves.push((s.on_part, s.mask, s.feed));
+    let (segs, laid) = (course.segments.clone(), laying(p, c));
+    motion_of(p, segs.clone(), laid.start - segs.start, segs.end - laid.end)
+}
+
+/// The moves of optimized course `kc` to compare with an original course: its laying (see
+/// [`laying`]) with the `lead` moves before it and the `trail` moves after, wherever reading
+/// the optimized program put those. (Where an original approach or retract block is short,
+/// because nothing moved before the course or one move joined two courses, the regenerated
+/// transit, or the next course's approach, reads as part of it; such moves are off-part all the
+/// same.) `None` if the program has not that many moves there.
+fn window(p: &Program, kc: usize, lead: usize, trail: usize) -> Option<SpanMotion> {
+    let laid = laying(p, kc);
+    let (lo, hi) = (laid.start.checked_sub(lead)?, laid.end + trail);
+    if hi > p.segments.len() {
+        return None;
     }
-    SpanMotion { points, moves }
+    Some(motion_of(p, lo..hi, lead, trail))
 }
 
-fn same_value(machine: &Machine, i: usize, a: f64, b: f64, turn: f64, tol: f64) -> bool {
-    let d = b - a - turn;
-    if machine.axes[i].kind.wraps() || turn != 0.0 {
-        let r = d - 360.0 * (d / 360.0).round();
-        r.abs() <= tol
-    } else {
-        d.abs() <= tol
-    }
+/// The point where a course starts laying (forward) or ends laying, for finding candidates
+/// (for a course that lays nothing, where its on-part block sits).
+fn laying_point(p: &Program, c: usize, end: bool) -> &[f64] {
+    let laid = laying(p, c);
+    let at = match (laid.is_empty(), end) {
+        (false, true) => p.segments[laid.end - 1].to,
+        _ => point_before(p, laid.start),
+    };
+    p.point(at)
 }
 
-fn same_feed(a: f64, b: f64) -> bool {
-    (a.is_nan() && b.is_nan()) || a == b
-}
-
-/// Checks that `opt`'s course `kc` is `orig`'s course `oc` laid forward.
+/// Checks that optimized course `kc` is original course `oc` laid forward.
 fn is_forward(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Machine, tol: f64) -> Result<(), String> {
-    let (a, b) = (span_motion(orig, oc), span_motion(opt, kc));
+    let a = span_motion(orig, oc);
+    let Some(b) = window(opt, kc, a.lead, a.trail) else {
+        return Err(format!("fewer than {} moves around its laid moves", a.lead + a.trail));
+    };
     if a.moves.len() != b.moves.len() {
         return Err(format!("{} moves instead of {}", b.moves.len(), a.moves.len()));
     }
@@ -290,9 +354,13 @@ fn is_forward(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Mac
     Ok(())
 }
 
-/// Checks that `opt`'s course `kc` is `orig`'s course `oc` legally reversed.
+/// Checks that optimized course `kc` is original course `oc` legally reversed.
 fn is_reversal(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Machine, tol: f64) -> Result<(), String> {
-    let (a, b) = (span_motion(orig, oc), span_motion(opt, kc));
+    let a = span_motion(orig, oc);
+    // Reversed, the original's retract leads and its approach trails.
+    let Some(b) = window(opt, kc, a.trail, a.lead) else {
+        return Err(format!("fewer than {} moves around its laid moves", a.lead + a.trail));
+    };
     let n = a.moves.len();
     if n != b.moves.len() {
         return Err(format!("{} moves instead of {}", b.moves.len(), n));
@@ -332,6 +400,20 @@ fn is_reversal(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Ma
         }
     }
     Ok(())
+}
+
+fn same_value(machine: &Machine, i: usize, a: f64, b: f64, turn: f64, tol: f64) -> bool {
+    let d = b - a - turn;
+    if machine.axes[i].kind.wraps() || turn != 0.0 {
+        let r = d - 360.0 * (d / 360.0).round();
+        r.abs() <= tol
+    } else {
+        d.abs() <= tol
+    }
+}
+
+fn same_feed(a: f64, b: f64) -> bool {
+    (a.is_nan() && b.is_nan()) || a == b
 }
 
 fn span_text(p: &Program, c: usize) -> String {
@@ -401,84 +483,157 @@ fn match_courses(
     let mut by_end: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
     let mut by_start: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
     for c in (0..k).rev() {
-        let key: Vec<i64> = point_cell(machine, &orig.courses[c].exit.phys).iter().map(|x| x.0).collect();
+        // Keyed by where laying starts and ends: the approach and retract around it may have
+        // taken in transit moves in the optimized program (see `extra`).
+        let key: Vec<i64> = point_cell(machine, laying_point(orig, c, true)).iter().map(|x| x.0).collect();
         by_end.entry(key).or_default().push(c);
-        let key: Vec<i64> = point_cell(machine, &orig.courses[c].span_start.phys).iter().map(|x| x.0).collect();
+        let key: Vec<i64> = point_cell(machine, laying_point(orig, c, false)).iter().map(|x| x.0).collect();
         by_start.entry(key).or_default().push(c);
     }
+    // Moves each original course has around its laying (approach and retract).
+    let around: Vec<usize> = (0..k).map(|c| orig.courses[c].segments.len() - laying(orig, c).len()).collect();
+    // Candidates near a point, those with the most moves around their laying first: of two
+    // courses that lay the same, the one that also needs a retract (say) must take the
+    // optimized course that has it, leaving the other for one that may not.
     let near = |map: &HashMap<Vec<i64>, Vec<usize>>, p: &[f64]| -> Vec<usize> {
         let mut v: Vec<usize> = neighbour_cells(&point_cell(machine, p))
             .iter()
             .filter_map(|key| map.get(key))
             .flat_map(|v| v.iter().copied())
             .collect();
-        v.sort_unstable();
+        v.sort_unstable_by_key(|&c| (std::cmp::Reverse(around[c]), c));
+        v.dedup();
         v
     };
-    let mut used = vec![false; k];
-    let mut order = Vec::with_capacity(k);
-    let mut rewritten = Vec::with_capacity(k);
-    for kc in 0..k {
-        let text = span_text(opt, kc);
-        let mut found = None;
+    // Every original course that optimized course `kc` may be, in order of preference: same
+    // lines, then same motion forward, then a legal reversal. With `unused`, stops at the first
+    // candidate not yet taken. Each comes with "same lines" and, if there is none, why.
+    let candidates = |kc: usize, unused: Option<&[bool]>| -> (Vec<(Placement, bool)>, String) {
+        let mut out: Vec<(Placement, bool)> = Vec::new();
         let mut detail = String::new();
+        let take = |oc: usize| unused.is_none_or(|u| u[oc]);
+        let done = |out: &Vec<(Placement, bool)>| unused.is_some() && !out.is_empty();
+        let text = span_text(opt, kc);
         if let Some(cands) = by_text.get(&text) {
             for &oc in cands.iter().rev() {
-                if used[oc] {
+                if !take(oc) {
                     continue;
                 }
                 match is_forward(orig, oc, opt, kc, machine, tol) {
                     Ok(()) => {
-                        found = Some(Placement { course: oc, reversed: false });
-                        break;
+                        out.push((Placement { course: oc, reversed: false }, true));
+                        if done(&out) {
+                            return (out, detail);
+                        }
                     }
                     Err(e) => detail = format!(": same lines as {} but {e}", orig.course_name(oc)),
                 }
             }
         }
-        let by_text = found.is_some();
-        let start = &opt.courses[kc].span_start.phys;
-        if found.is_none() {
-            for oc in near(&by_start, start) {
-                if !used[oc] && is_forward(orig, oc, opt, kc, machine, tol).is_ok() {
-                    found = Some(Placement { course: oc, reversed: false });
-                    break;
-                }
-            }
-        }
-        if found.is_none() {
-            let cands = near(&by_end, start);
-            if cands.is_empty() && detail.is_empty() {
-                detail = ": no course of the original ends where it starts".into();
-            }
+        let start = laying_point(opt, kc, false);
+        for oc in near(&by_start, start) {
+            if take(oc) && !out.iter().any(|x| x.0.course == oc) && is_forward(orig, oc, opt, kc, machine, tol).is_ok()
             {
-                for &oc in cands.iter() {
-                    if used[oc] {
-                        continue;
-                    }
-                    match is_reversal(orig, oc, opt, kc, machine, tol) {
-                        Ok(()) => {
-                            found = Some(Placement { course: oc, reversed: true });
-                            break;
-                        }
-                        Err(e) => detail = format!(": not a legal reversal of {}: {e}", orig.course_name(oc)),
-                    }
+                out.push((Placement { course: oc, reversed: false }, false));
+                if done(&out) {
+                    return (out, detail);
                 }
             }
         }
-        match found {
-            Some(p) => {
-                used[p.course] = true;
-                rewritten.push(!by_text);
-                order.push(p);
+        let cands = near(&by_end, start);
+        if cands.is_empty() && detail.is_empty() && out.is_empty() {
+            detail = ": no course of the original stops laying where it starts".into();
+        }
+        for oc in cands {
+            if !take(oc) || out.iter().any(|x| x.0.course == oc) {
+                continue;
             }
-            None => return Err(VerifyError::Unmatched { line: opt.courses[kc].on_part.start + 1, detail }),
+            match is_reversal(orig, oc, opt, kc, machine, tol) {
+                Ok(()) => {
+                    out.push((Placement { course: oc, reversed: true }, false));
+                    if done(&out) {
+                        return (out, detail);
+                    }
+                }
+                Err(e) => detail = format!(": not a legal reversal of {}: {e}", orig.course_name(oc)),
+            }
+        }
+        (out, detail)
+    };
+    // Greedy in program order; where a course finds every candidate taken (courses alike but
+    // for their approach or retract), an augmenting path re-assigns earlier ones.
+    let mut unused = vec![true; k];
+    let mut owner: Vec<Option<usize>> = vec![None; k];
+    let mut chosen: Vec<Option<(Placement, bool)>> = vec![None; k];
+    let mut all: HashMap<usize, Vec<(Placement, bool)>> = HashMap::new();
+    for kc in 0..k {
+        let (first, detail) = candidates(kc, Some(&unused));
+        if let Some(&(p, text)) = first.first() {
+            unused[p.course] = false;
+            owner[p.course] = Some(kc);
+            chosen[kc] = Some((p, text));
+            continue;
+        }
+        let (list, _) = candidates(kc, None);
+        if list.is_empty() {
+            return Err(VerifyError::Unmatched { line: opt.courses[kc].on_part.start + 1, detail });
+        }
+        all.insert(kc, list);
+        let mut seen = vec![false; k];
+        if !augment(kc, &mut seen, &mut owner, &mut chosen, &mut all, &candidates) {
+            return Err(VerifyError::Unmatched {
+                line: opt.courses[kc].on_part.start + 1,
+                detail: ": every course of the original it could be is laid elsewhere".into(),
+            });
+        }
+        for (u, o) in unused.iter_mut().zip(&owner) {
+            *u = o.is_none();
         }
     }
-    if let Some(c) = used.iter().position(|u| !u) {
+    let mut order = Vec::with_capacity(k);
+    let mut rewritten = Vec::with_capacity(k);
+    for c in chosen {
+        let Some((p, text)) = c else {
+            return Err(VerifyError::Missing(String::from("a course")));
+        };
+        order.push(p);
+        rewritten.push(!text);
+    }
+    if let Some(c) = owner.iter().position(Option::is_none) {
         return Err(VerifyError::Missing(orig.course_name(c)));
     }
     Ok((order, rewritten))
+}
+
+/// Kuhn's augmenting path: gives optimized course `kc` one of its candidates, moving the
+/// courses that hold them to other candidates of theirs if need be.
+fn augment<F>(
+    kc: usize,
+    seen: &mut [bool],
+    owner: &mut [Option<usize>],
+    chosen: &mut [Option<(Placement, bool)>],
+    all: &mut HashMap<usize, Vec<(Placement, bool)>>,
+    candidates: &F,
+) -> bool
+where
+    F: Fn(usize, Option<&[bool]>) -> (Vec<(Placement, bool)>, String),
+{
+    let list = all.entry(kc).or_insert_with(|| candidates(kc, None).0).clone();
+    for (p, text) in list {
+        if std::mem::replace(&mut seen[p.course], true) {
+            continue;
+        }
+        let free = match owner[p.course] {
+            None => true,
+            Some(other) => augment(other, seen, owner, chosen, all, candidates),
+        };
+        if free {
+            owner[p.course] = Some(kc);
+            chosen[kc] = Some((p, text));
+            return true;
+        }
+    }
+    false
 }
 
 /// A line that must survive: not a move, and no tow, contact or mode codes (those are checked
@@ -509,6 +664,9 @@ fn check_kept_lines(
         *have.entry(l.trim_end_matches('\r')).or_default() += 1;
     }
     let mut need: Vec<(usize, String)> = Vec::new();
+    // Text kept from transit lines: on a line of its own, or, where the transit itself was
+    // kept (the original order), on the original line.
+    let mut kept: Vec<(usize, &str)> = Vec::new();
     for j in (0..orig.header_end).chain(orig.footer_start..orig.lines.len()) {
         need.push((j, orig.lines[j].clone()));
     }
@@ -516,7 +674,7 @@ fn check_kept_lines(
         for item in course.pre_before.iter().chain(&course.pre_after).chain(&course.post) {
             match item {
                 Item::Line(j) => need.push((*j, orig.lines[*j].clone())),
-                Item::Kept(j, t) => need.push((*j, t.clone())),
+                Item::Kept(j, t) => kept.push((*j, t)),
             }
         }
     }
@@ -532,6 +690,19 @@ fn check_kept_lines(
         match have.get_mut(t) {
             Some(n) if *n > 0 => *n -= 1,
             _ => return Err(VerifyError::LostLine { line: j + 1, text: t.to_string() }),
+        }
+    }
+    for (j, t) in kept {
+        let whole = orig.lines[j].trim_end_matches('\r');
+        let found = [whole, t].into_iter().any(|x| match have.get_mut(x) {
+            Some(n) if *n > 0 => {
+                *n -= 1;
+                true
+            }
+            _ => false,
+        });
+        if !found {
+            return Err(VerifyError::LostLine { line: j + 1, text: t.to_string() });
         }
     }
     Ok(())
@@ -615,6 +786,84 @@ fn check_precedence(orig: &Program, fps: &Footprints, order: &[Placement]) -> Re
     Ok(())
 }
 
+/// Seed 000's precedence sets, found here on their own: the plies in program order, each
+/// joining the current set unless one of its courses overlaps a course already in it, else
+/// starting the next set. Returns the set of each course (sets numbered from 0).
+fn sets_of_courses(plies: &[Vec<usize>], fps: &Footprints) -> Vec<usize> {
+    let mut widths: Vec<f64> = fps.courses.iter().flat_map(|f| f.quads.iter().map(|q| q.hw)).collect();
+    widths.sort_by(f64::total_cmp);
+    let cell = widths.get(widths.len() / 2).map_or(10.0, |w| (8.0 * w).max(1e-2));
+    let rows = fps.frame.period().map(|p| ((p / cell).ceil().max(1.0)) as i64);
+    let hcell = match (fps.frame.period(), rows) {
+        (Some(p), Some(r)) => p / r as f64,
+        _ => cell,
+    };
+    let cells_of = |q: &crate::footprint::Quad| {
+        let (lo, hi) = q.bounds();
+        let (i0, i1) = ((lo[0] / cell).floor() as i64, (hi[0] / cell).floor() as i64);
+        let (j0, j1) = ((lo[1] / hcell).floor() as i64, (hi[1] / hcell).floor() as i64);
+        (i0..=i1).flat_map(move |i| {
+            (j0..=j1).map(move |j| match rows {
+                Some(r) => (i, j.rem_euclid(r)),
+                None => (i, j),
+            })
+        })
+    };
+    let mut set_of = vec![0usize; fps.courses.len()];
+    let mut set = 0;
+    // The current set's pieces, by cell.
+    let mut grid: HashMap<(i64, i64), Vec<(usize, usize)>> = HashMap::new();
+    for ply in plies {
+        let meets = ply.iter().any(|&c| {
+            fps.courses[c].quads.iter().any(|q| {
+                cells_of(q).any(|key| {
+                    grid.get(&key).is_some_and(|v| {
+                        v.iter()
+                            .any(|&(x, qx)| crate::precedence::quads_overlap(&fps.frame, q, &fps.courses[x].quads[qx]))
+                    })
+                })
+            })
+        });
+        if meets {
+            set += 1;
+            grid.clear();
+        }
+        for &c in ply {
+            set_of[c] = set;
+            for (qi, q) in fps.courses[c].quads.iter().enumerate() {
+                for key in cells_of(q) {
+                    grid.entry(key).or_default().push((c, qi));
+                }
+            }
+        }
+    }
+    set_of
+}
+
+/// Every course of a seed-000 precedence set must be laid before any course of the next.
+fn check_sets(orig: &Program, fps: &Footprints, order: &[Placement]) -> Result<(), VerifyError> {
+    let plies: Vec<Vec<usize>> = orig.plies.iter().map(|p| p.courses.clone()).collect();
+    let set_of = sets_of_courses(&plies, fps);
+    let mut latest: Option<usize> = None;
+    for p in order {
+        if let Some(l) = latest {
+            if set_of[p.course] < set_of[l] {
+                return Err(VerifyError::Order(format!(
+                    "{} (seed-000 precedence set {}) is laid after {} (set {}): each set must be finished before the next starts",
+                    orig.course_name(p.course),
+                    set_of[p.course] + 1,
+                    orig.course_name(l),
+                    set_of[l] + 1
+                )));
+            }
+        }
+        if latest.is_none_or(|l| set_of[p.course] >= set_of[l]) {
+            latest = Some(p.course);
+        }
+    }
+    Ok(())
+}
+
 /// Motion of a program under every cost model the machine supports; `course_of[c]` maps the
 /// program's course c to the index it is reported under. Lines before `header_end` and from
 /// `footer_start` count as header and footer.
@@ -660,4 +909,51 @@ pub fn measure(
         out.push(m);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::footprint::{Footprint, Frame, Quad};
+    use proptest::prelude::*;
+
+    fn band(a: [f64; 2], b: [f64; 2], w: f64) -> Footprint {
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
+        let q = Quad {
+            c: [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0],
+            u: [d[0] / len, d[1] / len],
+            hl: len / 2.0,
+            hw: w / 2.0 - 0.005,
+        };
+        Footprint { quads: vec![q], moves: vec![q], move_of: vec![0], paths: vec![vec![a, b]] }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// The verifier's own seed-000 sets are the optimizer's (`precedence_sets`), found by
+        /// other code.
+        #[test]
+        fn verifier_sets_agree_with_the_optimizer_s(
+            seed in proptest::collection::vec((0.0f64..400.0, 0.0f64..400.0, 0.0f64..std::f64::consts::PI, 10.0f64..120.0, 4.0f64..30.0), 2..30),
+            per_ply in 1usize..5,
+        ) {
+            let courses: Vec<Footprint> =
+                seed.iter().map(|&(x, y, a, l, w)| band([x, y], [x + l * a.cos(), y + l * a.sin()], w)).collect();
+            let n = courses.len();
+            let plies: Vec<Vec<usize>> = (0..n).collect::<Vec<_>>().chunks(per_ply).map(|c| c.to_vec()).collect();
+            let fps = Footprints { frame: Frame::Plan, courses };
+            let mine = sets_of_courses(&plies, &fps);
+            let theirs = crate::precedence::precedence_sets(&fps, &plies);
+            let mut expect = vec![usize::MAX; n];
+            for (s, ps) in theirs.iter().enumerate() {
+                for &p in ps {
+                    for &c in &plies[p] {
+                        expect[c] = s;
+                    }
+                }
+            }
+            prop_assert_eq!(mine, expect);
+        }
+    }
 }

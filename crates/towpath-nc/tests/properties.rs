@@ -35,6 +35,8 @@ struct CourseSpec {
     mask: u64,
     mid_cut: Option<(usize, u64)>,
     extra: u8,
+    /// The last on-part move is a clockwise arc (radius = its chord), which cannot be reversed.
+    arc: bool,
 }
 
 #[derive(Clone, Debug)]
@@ -48,9 +50,16 @@ struct PartSpec {
 fn course_spec() -> impl Strategy<Value = CourseSpec> {
     (
         (0.0f64..300.0, 0.0f64..300.0, 0.0f64..std::f64::consts::TAU, 20.0f64..250.0),
-        (1usize..5, 0u32..3600, 1u64..16, proptest::option::of((0usize..4, 1u64..16)), 0u8..4),
+        (
+            1usize..5,
+            0u32..3600,
+            1u64..16,
+            proptest::option::of((0usize..4, 1u64..16)),
+            0u8..4,
+            proptest::bool::weighted(0.2),
+        ),
     )
-        .prop_map(|((x, y, angle, len), (points, h, mask, mid, extra))| CourseSpec {
+        .prop_map(|((x, y, angle, len), (points, h, mask, mid, extra, arc))| CourseSpec {
             x: (x * 1000.0).round() / 1000.0,
             y: (y * 1000.0).round() / 1000.0,
             angle,
@@ -64,6 +73,7 @@ fn course_spec() -> impl Strategy<Value = CourseSpec> {
                 (points > 1 && c != 0 && c != mask).then(|| (1 + at % (points - 1), c))
             }),
             extra,
+            arc,
         })
 }
 
@@ -117,7 +127,12 @@ fn program(spec: &PartSpec) -> String {
                 let (x, y) = pt(k);
                 let feed = if k == 1 { " F2500" } else { "" };
                 let comment = if c.extra == 2 && k == 1 { " (first move)" } else { "" };
-                l.push(format!("G1 X{} Y{}{feed}{comment}", n(x), n(y)));
+                if c.arc && k == c.points {
+                    let r = n(c.len / c.points as f64);
+                    l.push(format!("G2 X{} Y{} R{r}{feed}{comment}", n(x), n(y)));
+                } else {
+                    l.push(format!("G1 X{} Y{}{feed}{comment}", n(x), n(y)));
+                }
                 if let Some((at, cut)) = c.mid_cut {
                     if at == k {
                         l.push(format!("M61 P{cut}"));
@@ -194,7 +209,10 @@ proptest! {
         let opts = AfpOptions { bidirectional: true, width: Some(Width::Tow(6.0)), cost: CostKind::Axis, ..AfpOptions::default() };
         let afp = build_problem(&p, &m, &d, &opts).unwrap();
         let rev_ok: Vec<bool> = (0..p.courses.len()).map(|c| afp.reversed[c].is_some()).collect();
-        prop_assert!(rev_ok.iter().all(|&r| r));
+        let arcs: Vec<bool> = spec.plies.iter().flatten().map(|c| c.arc).collect();
+        for c in 0..p.courses.len() {
+            prop_assert_eq!(rev_ok[c], !arcs[c], "course {} reversible unless it holds an arc", c);
+        }
         let order = random_order(p.courses.len(), afp.problem.precedence(), &rev_ok, seed);
         let steps: Vec<Step> = order.iter().map(|pl| Step { task: TaskId(pl.course as u32), mode: pl.reversed as u32 }).collect();
         let route = check(&afp.problem, &steps).unwrap();
@@ -208,10 +226,12 @@ proptest! {
             let measured: f64 = a.off_course.iter().sum();
             prop_assert!((measured - route).abs() <= 1e-6 * (1.0 + route), "measured {} route {}", measured, route);
         }
-        // A reversed course reversed again is the original course.
+        // Every course reverses with the heading turned half a turn, but those holding an arc.
         for c in 0..p.courses.len() {
-            let r = reverse_course(&p, c, &m, &d).unwrap();
-            prop_assert!(r.shift.abs() == 180.0);
+            match reverse_course(&p, c, &m, &d) {
+                Ok(r) => prop_assert!(r.shift.abs() == 180.0 && !arcs[c]),
+                Err(why) => prop_assert!(arcs[c] && why.contains("arc"), "{}", why),
+            }
         }
     }
 
@@ -303,6 +323,8 @@ proptest! {
             Just("(PLY 1)".to_string()), Just("(COURSE 2)".to_string()),
             Just("G91".to_string()), Just("G90".to_string()), Just("G92 C10".to_string()),
             Just("X-5".to_string()), Just("%".to_string()), Just("G2 X1".to_string()),
+            Just("G2 X30 Y10 R20".to_string()), Just("G3 X5 I-5 J0".to_string()), Just("G18".to_string()),
+            Just("G2 X0 Z5 I-5 K0".to_string()), Just("I3 J4".to_string()),
             "[ -~]{0,20}",
         ], 0..40)) {
         let text = lines.join("\n");

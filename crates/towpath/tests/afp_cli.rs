@@ -184,3 +184,48 @@ fn optimize_with_each_solver() {
     assert!(err.contains("planar-0.nc") && err.contains("doherty") && err.contains("--keep-ply-order"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// The flags not shown above: `--course-width`, `--report x.html`, the two widths
+/// refused together, and `verify --precedence sets` holding an output to seed 000's sets.
+#[test]
+fn course_width_html_report_and_sets_precedence() {
+    let d = temp_dir("sets");
+    demo(&d);
+    let out = d.join("sets.nc");
+    let html = d.join("sets.html");
+    let base = |cmd: &mut Command| {
+        cmd.arg("--machine").arg(d.join("gantry-afp.toml")).args(["--course-width", "50.8"]);
+    };
+    let mut cmd = towpath();
+    cmd.arg("optimize").arg(d.join("planar-0.nc"));
+    base(&mut cmd);
+    cmd.args(["--precedence", "sets", "--time-limit", "0.2", "--threads", "1", "-o"])
+        .arg(&out)
+        .arg("--report")
+        .arg(&html);
+    let (code, stdout, err) = run(&mut cmd);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("verified"), "{stdout}");
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(
+        page.starts_with("<!doctype html>") && page.matches("<svg").count() == 2,
+        "{}",
+        &page[..200.min(page.len())]
+    );
+    let mut cmd = towpath();
+    cmd.arg("verify").arg(d.join("planar-0.nc")).arg(&out);
+    base(&mut cmd);
+    cmd.args(["--precedence", "sets"]);
+    let (code, stdout, err) = run(&mut cmd);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("seed 000's precedence sets in order"), "{stdout}");
+    // Both widths at once: refused by the argument parser.
+    let mut cmd = towpath();
+    cmd.arg("verify").arg(d.join("planar-0.nc")).arg(&out);
+    base(&mut cmd);
+    cmd.args(["--tow-width", "6.35"]);
+    let (code, _, err) = run(&mut cmd);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--tow-width") && err.contains("--course-width"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use towpath_nc::{totals, verify, VerifyError, VerifyOptions};
+use towpath_nc::{totals, verify, PrecedenceRule, VerifyError, VerifyOptions};
 
 use super::afp_common::{read, MachineArgs};
 use crate::exit;
@@ -19,7 +19,12 @@ pub struct Args {
     pub optimized: PathBuf,
     #[command(flatten)]
     pub machine: MachineArgs,
-    /// Also require every ply to be finished before the next one starts.
+    /// The precedence the optimized program must keep: a course after the courses of earlier
+    /// plies it overlaps (courses, always checked), and also seed 000's precedence sets in order
+    /// (sets) or every ply finished before the next starts (plies), as `optimize --precedence`.
+    #[arg(long, default_value = "courses", value_name = "courses|sets|plies")]
+    pub precedence: PrecedenceRule,
+    /// Also require every ply to be finished before the next one starts (`--precedence plies`).
     #[arg(long)]
     pub strict_plies: bool,
     /// Also require the courses of each ply in their original order.
@@ -35,7 +40,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let (machine, dialect, width) = args.machine.load()?;
     let original = read(&args.original)?;
     let optimized = read(&args.optimized)?;
-    let opts = VerifyOptions { width, strict_plies: args.strict_plies, keep_ply_order: args.keep_ply_order };
+    let opts = VerifyOptions {
+        width,
+        strict_plies: args.strict_plies || args.precedence == PrecedenceRule::Plies,
+        keep_ply_order: args.keep_ply_order,
+        seed000_sets: args.precedence == PrecedenceRule::Sets,
+    };
     let v = verify(&original, &optimized, &machine, &dialect, &opts).map_err(|e| match e {
         VerifyError::Original(e) => exit::bad_input(anyhow::anyhow!("{}: {e}", args.original.display())),
         VerifyError::Optimized(e) => exit::bad_input(anyhow::anyhow!("{}: {e}", args.optimized.display())),
@@ -62,7 +72,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "verified: {} courses, same motion on-part ({} laid in reverse), precedence {}",
         v.courses,
         v.reversed,
-        if v.precedence_checked { "kept" } else { "not needed (one ply)" }
+        match (v.precedence_checked, opts.seed000_sets, opts.strict_plies) {
+            (false, ..) => "not needed (one ply)",
+            (true, true, _) => "kept (and seed 000's precedence sets in order)",
+            (true, _, true) => "kept (and ply by ply)",
+            (true, ..) => "kept",
+        }
     );
     println!(
         "  {:<6} {:>14} {:>14} {:>8} {:>14} {:>14} {:>8}",
