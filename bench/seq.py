@@ -51,6 +51,19 @@ PEER_KINDS = {
 # --------------------------------------------------------------------------- environment
 
 
+
+def load_note(load_vals):
+    """How busy the machine was: quiet when the 1-minute load stayed near the benchmark's own threads."""
+    med = seqlib.median(load_vals) or 0
+    span = f"median {med:.1f} (min {min(load_vals, default=0):.1f}, max {max(load_vals, default=0):.1f})"
+    cores = os.cpu_count() or 2
+    if med <= cores + 0.5:
+        return (f"Quiet: no other jobs ran; 1-minute load average during the runs {span}, the benchmark's own "
+                f"solver threads.")
+    return (f"**Taken under load**: other jobs ran on the same {cores} cores; 1-minute load average during the "
+            f"runs {span}. Wall times and solution quality at a fixed limit are therefore pessimistic and noisy "
+            f"for every solver.")
+
 def venv_python() -> Path:
     return VENV / "bin" / "python"
 
@@ -655,10 +668,7 @@ def write_report(args, index, instances, peers, scale, data) -> None:
         f"{args.time_limit:g} s, {runs} run(s) per solver and instance (seeds 1..{runs}), medians shown; "
         f"towpath with `--threads {args.threads}`.",
         f"",
-        f"- Machine: {machine()}. **Taken under load**: other jobs were compiling on the same 2 cores; "
-        f"1-minute load average during the runs: median "
-        f"{seqlib.median(load_vals) or 0:.1f} (min {min(load_vals, default=0):.1f}, max {max(load_vals, default=0):.1f}). "
-        f"Wall times and solution quality at a fixed limit are therefore pessimistic and noisy for every solver.",
+        f"- Machine: {machine()}. " + load_note(load_vals),
         f"- Versions: {tp_version} (commit {git}); " + ", ".join(f"{k} {v}" for k, v in vers.items())
         + f"; Python {platform.python_version()}.",
         f"- Instances: `{args.instances.relative_to(ROOT) if args.instances.is_relative_to(ROOT) else args.instances}` "
