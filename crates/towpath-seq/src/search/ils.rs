@@ -58,6 +58,9 @@ pub(crate) struct Budget {
     /// The end of the search: a local search still running then is cut short and its kick
     /// undone, so that the best tour is always a local optimum.
     pub hard: Option<Instant>,
+    /// Acceptance temperature: a kick that makes the tour dearer by Δ is kept with probability
+    /// exp(-Δ / temperature) (0: only kicks that do not make it dearer).
+    pub temperature: Cost,
 }
 
 pub(crate) struct Ils<'a, 'p, C> {
@@ -184,11 +187,19 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
                     best.mode.copy_from_slice(&cur.mode);
                     best.cost = cur.cost;
                 }
+            } else if budget.temperature > 0.0 && self.accept_worse(cur.cost - before, budget.temperature, rng) {
+                cur.commit();
             } else {
                 cur.undo();
             }
         }
         kicks
+    }
+
+    /// Simulated-annealing acceptance of a kick that made the tour dearer by `delta`.
+    fn accept_worse(&self, delta: Cost, temperature: Cost, rng: &mut Pcg64Mcg) -> bool {
+        // a forbidden transition is never kept
+        delta < 0.5 * self.net.forbidden && rng.gen::<f64>() < (-delta / temperature).exp()
     }
 
     /// A double-bridge kick: exchanges two short adjacent segments, if precedence and groups

@@ -64,7 +64,18 @@ pub(crate) struct Net<'p, C> {
     pub forbidden: Cost,
     /// Mean of a sample of finite transition costs (at least 1).
     pub typical_arc: Cost,
+    /// Every arc, priced as [`Net::arc`] does, by dense index (see [`Net::dense_index`]) when
+    /// the table is small enough; empty otherwise.
+    dense: Vec<Cost>,
+    /// Width of `dense` (0 when there is no table).
+    dense_w: usize,
 }
+
+/// Largest number of (node, mode) pairs for which the arcs are tabulated (a table of at most
+/// 2048² costs, 32 MiB). Cost models with positions are tabulated only up to `DENSE_POINTS`:
+/// beyond that computing a distance is cheaper than a cache miss.
+const DENSE_MAX: usize = 2048;
+const DENSE_POINTS: usize = 1100;
 
 impl<'p, C: CostModel> Net<'p, C> {
     pub fn new(p: &'p Problem<C>) -> Self {
@@ -163,12 +174,54 @@ impl<'p, C: CostModel> Net<'p, C> {
             multi_mode: p.max_modes() > 1,
             forbidden: f64::INFINITY,
             typical_arc: 1.0,
+            dense: Vec::new(),
+            dense_w: 0,
         };
         let (mean, max) = net.sample_arcs();
         net.typical_arc = mean;
         net.forbidden = (max * 1e6).max(MIN_FORBIDDEN);
         net.wrap_ok = net.reversal_symmetric && depot_symmetric && !net.has_prec && !net.has_groups;
+        net.tabulate();
         net
+    }
+
+    /// Fills the dense arc table when it is small enough to pay off.
+    fn tabulate(&mut self) {
+        let total_modes = self.entry.len();
+        let w = total_modes + usize::from(self.depot != u32::MAX);
+        let has_positions = self.n_tasks > 0 && self.p.cost_model().position(StateId(0)).is_some();
+        let limit = if has_positions { DENSE_POINTS } else { DENSE_MAX };
+        if w > limit || w == 0 {
+            return;
+        }
+        // (node, mode) of every dense index
+        let mut of: Vec<(u32, u32)> = Vec::with_capacity(w);
+        for v in 0..self.n_tasks as u32 {
+            for m in 0..self.num_modes(v) {
+                of.push((v, m));
+            }
+        }
+        if self.depot != u32::MAX {
+            of.push((self.depot, 0));
+        }
+        let mut dense = Vec::with_capacity(w * w);
+        for &(a, ma) in &of {
+            for &(b, mb) in &of {
+                dense.push(self.raw_arc(a, ma, b, mb).min(self.forbidden).max(-self.forbidden));
+            }
+        }
+        self.dense = dense;
+        self.dense_w = w;
+    }
+
+    /// Index of `(v, m)` in the dense table: the global mode index, the depot last.
+    #[inline]
+    fn dense_index(&self, v: u32, m: u32) -> usize {
+        if v == self.depot {
+            self.dense_w - 1
+        } else {
+            (self.mode_base[v as usize] + m) as usize
+        }
     }
 
     /// Number of modes of a node (the depot has one).
@@ -200,6 +253,9 @@ impl<'p, C: CostModel> Net<'p, C> {
     /// (non-finite) transitions priced at `self.forbidden` so that cost differences stay finite.
     #[inline]
     pub fn arc(&self, a: u32, ma: u32, b: u32, mb: u32) -> Cost {
+        if self.dense_w != 0 {
+            return self.dense[self.dense_index(a, ma) * self.dense_w + self.dense_index(b, mb)];
+        }
         // `min` maps +inf and NaN to the forbidden price
         self.raw_arc(a, ma, b, mb).min(self.forbidden).max(-self.forbidden)
     }
@@ -352,4 +408,41 @@ fn csr(n: usize, edges: impl Iterator<Item = (u32, u32)> + Clone) -> (Vec<u32>, 
         fill[a as usize] += 1;
     }
     (off, out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cost::MatrixCost;
+    use crate::model::Mode;
+
+    /// The dense table gives every arc exactly as the cost model does, through modes, the depot
+    /// and forbidden transitions.
+    #[test]
+    fn dense_table_matches_the_cost_model() {
+        let s = 7usize;
+        let mut m: Vec<Cost> = (0..s * s).map(|k| ((k * 37) % 23) as Cost + 0.5).collect();
+        m[3 * s + 4] = Cost::INFINITY;
+        let cost = MatrixCost::new(s, m).unwrap();
+        let mut b = Problem::builder(cost);
+        b.task(vec![Mode::new(StateId(1), StateId(2)), Mode::new(StateId(2), StateId(1))]);
+        b.task(vec![Mode::point(StateId(3))]);
+        b.task(vec![Mode::new(StateId(4), StateId(5)), Mode::new(StateId(5), StateId(4)), Mode::point(StateId(6))]);
+        b.start(StateId(0)).end(End::At(StateId(6)));
+        let p = b.build().unwrap();
+        let net = Net::new(&p);
+        assert_eq!(net.dense_w, 7, "six modes and the depot");
+        let nodes: Vec<u32> = (0..net.n as u32).collect();
+        for &a in &nodes {
+            for ma in 0..net.num_modes(a) {
+                for &b in &nodes {
+                    for mb in 0..net.num_modes(b) {
+                        let want = net.raw_arc(a, ma, b, mb).min(net.forbidden).max(-net.forbidden);
+                        assert_eq!(net.arc(a, ma, b, mb), want, "arc {a}/{ma} -> {b}/{mb}");
+                    }
+                }
+            }
+        }
+        assert_eq!(net.arc(1, 0, 2, 0), net.forbidden, "state 3 -> 4 is forbidden");
+    }
 }
