@@ -282,6 +282,5 @@ fn castelino_on_built_gtsp_and_pcgtsp_instances() {
             }
         }
     }
-    eprintln!("OPT {optimal}/{total}");
     assert!(optimal * 10 >= total * 8, "castelino optimal on {optimal} of {total}");
 }
