@@ -229,3 +229,74 @@ fn course_width_html_report_and_sets_precedence() {
     assert!(err.contains("--tow-width") && err.contains("--course-width"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `-o` or `--report` naming an input (however spelt, or through a link) is refused before
+/// anything is written, so the input survives; so is a report over the output. A path that
+/// cannot be written is a bad argument (exit 2), and a time limit too large for a duration is
+/// refused, not a panic.
+#[test]
+fn outputs_never_overwrite_inputs() {
+    let d = temp_dir("overwrite");
+    demo(&d);
+    let program = d.join("planar-0.nc");
+    let original = std::fs::read(&program).unwrap();
+    let hard = d.join("hard.nc");
+    std::fs::hard_link(&program, &hard).unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(&program, d.join("link.nc")).unwrap();
+    let spelt_again = d.join(".").join("planar-0.nc");
+    let optimize = |extra: &[&std::ffi::OsStr]| {
+        run(towpath()
+            .arg("optimize")
+            .arg(&program)
+            .arg("--machine")
+            .arg(d.join("gantry-afp.toml"))
+            .arg("--dialect")
+            .arg(d.join("dialect.toml"))
+            .args(["--time-limit", "0.05", "--threads", "1"])
+            .args(extra))
+    };
+    let os = |p: &Path| p.as_os_str().to_owned();
+    let cases: Vec<(Vec<std::ffi::OsString>, &str)> = vec![
+        (vec!["-o".into(), os(&program)], "the output would overwrite the program"),
+        (vec!["-o".into(), os(&spelt_again)], "the output would overwrite the program"),
+        (vec!["-o".into(), os(&hard)], "the output would overwrite the program"),
+        #[cfg(unix)]
+        (vec!["-o".into(), os(&d.join("link.nc"))], "the output would overwrite the program"),
+        (vec!["-o".into(), os(&d.join("dialect.toml"))], "the output would overwrite the dialect file"),
+        (
+            vec!["-o".into(), os(&d.join("x.nc")), "--report".into(), os(&program)],
+            "the report would overwrite the program",
+        ),
+        (
+            vec!["-o".into(), os(&d.join("x.nc")), "--report".into(), os(&d.join(".").join("x.nc"))],
+            "the report and the output would be the same file",
+        ),
+    ];
+    for (extra, message) in cases {
+        let args: Vec<&std::ffi::OsStr> = extra.iter().map(|a| a.as_os_str()).collect();
+        let (code, _, err) = optimize(&args);
+        assert_eq!(code, 2, "{extra:?}: {err}");
+        assert!(err.contains(message), "{extra:?}: {err}");
+        assert_eq!(std::fs::read(&program).unwrap(), original, "{extra:?} changed the input");
+        assert!(!d.join("x.nc").exists(), "{extra:?} wrote an output before refusing");
+    }
+    // An output under a file (not a directory): refused as a bad argument, naming the path.
+    let under_a_file = program.join("out.nc");
+    let (code, _, err) = optimize(&["-o".as_ref(), under_a_file.as_os_str()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("cannot create the directory"), "{err}");
+    for cmd in [&["optimize"][..], &["demo"][..]] {
+        let mut c = towpath();
+        c.args(cmd);
+        if cmd[0] == "optimize" {
+            c.arg(&program).arg("--machine").arg(d.join("gantry-afp.toml")).arg("-o").arg(d.join("y.nc"));
+        } else {
+            c.arg("--dir").arg(d.join("demo2"));
+        }
+        let (code, _, err) = run(c.args(["--time-limit", "1e300"]));
+        assert_eq!(code, 2, "{cmd:?}: {err}");
+        assert!(err.contains("--time-limit 1e300: too large"), "{cmd:?}: {err}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
