@@ -243,7 +243,7 @@ impl Dialect {
                 planes.len()
             )));
         }
-        Ok(Codes {
+        let codes = Codes {
             rapid: list("rapid", &self.rapid)?,
             feed: list("feed", &self.feed)?,
             arc_cw: any("arc_cw", &self.arc_cw)?,
@@ -258,7 +258,71 @@ impl Dialect {
             restart: code("tow_restart", &self.tow_restart)?,
             cut: code("tow_cut", &self.tow_cut)?,
             mask_word: letter("tow_mask_word", &self.tow_mask_word)?,
-        })
+        };
+        self.check_roles(&codes)?;
+        Ok(codes)
+    }
+
+    /// Every code has one role and the letter the interpreter reads it with (motion and mode
+    /// codes are G codes, contact and tow codes M codes); the word letters differ from each
+    /// other and from G and M; ply and course comments differ.
+    fn check_roles(&self, c: &Codes) -> Result<(), NcError> {
+        let non_motion = self
+            .non_motion_codes
+            .iter()
+            .map(|x| {
+                Code::parse(x).ok_or_else(|| NcError::Dialect(format!("non_motion_codes: {x:?} is not a code like G4")))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut roles: Vec<(&str, Code, char)> = Vec::new();
+        for (key, list) in [
+            ("rapid", &c.rapid),
+            ("feed", &c.feed),
+            ("arc_cw", &c.arc_cw),
+            ("arc_ccw", &c.arc_ccw),
+            ("arc_planes", &c.planes),
+            ("non_motion_codes", &non_motion),
+        ] {
+            roles.extend(list.iter().map(|&x| (key, x, 'G')));
+        }
+        roles.push(("absolute", c.absolute, 'G'));
+        roles.push(("incremental", c.incremental, 'G'));
+        roles.push(("set_position", c.set_position, 'G'));
+        if let Some((on, off)) = c.contact {
+            roles.push(("contact_on", on, 'M'));
+            roles.push(("contact_off", off, 'M'));
+        }
+        roles.push(("tow_restart", c.restart, 'M'));
+        roles.push(("tow_cut", c.cut, 'M'));
+        for (i, &(key, x, letter)) in roles.iter().enumerate() {
+            if x.letter != letter {
+                let article = if letter == 'M' { "an" } else { "a" };
+                return Err(NcError::Dialect(format!(
+                    "{key}: {x} is not {article} {letter} code (motion and mode codes are G codes, contact and tow codes M codes)"
+                )));
+            }
+            let same = |&&(k, y, _): &&(&str, Code, char)| k != key && y == x;
+            if let Some((other, ..)) = roles[..i].iter().find(same) {
+                return Err(NcError::Dialect(format!("{key}: {x} is also the dialect's {other} code")));
+            }
+        }
+        let words =
+            [("feed_word", c.feed_word), ("line_number_word", c.line_number_word), ("tow_mask_word", c.mask_word)];
+        for (i, &(key, l)) in words.iter().enumerate() {
+            if l == 'G' || l == 'M' {
+                return Err(NcError::Dialect(format!("{key}: {l} is the letter of G or M codes")));
+            }
+            if let Some((other, _)) = words[..i].iter().find(|w| w.1 == l) {
+                return Err(NcError::Dialect(format!("{key}: {l} is also the {other}")));
+            }
+        }
+        if self.ply_comment.trim().eq_ignore_ascii_case(self.course_comment.trim()) {
+            return Err(NcError::Dialect(format!(
+                "course_comment: {:?} is also the ply_comment: give courses another word (or \"\")",
+                self.course_comment
+            )));
+        }
+        Ok(())
     }
 
     /// Writes a comment in this dialect's style.
@@ -326,5 +390,29 @@ mod tests {
         assert!(e.to_string().contains("both"), "{e}");
         let e = Dialect::from_toml_str("tow_width = -3.0").unwrap_err();
         assert!(e.to_string().contains("tow_width"), "{e}");
+    }
+
+    /// A code with two roles, a code with the wrong letter (the interpreter reads motion and mode
+    /// codes only as G words, contact and tow codes only as M words), clashing word letters and
+    /// one marker word for plies and courses are refused with the key, not left to misread
+    /// programs.
+    #[test]
+    fn codes_with_two_roles_or_the_wrong_letter_are_refused() {
+        let refused = |toml: &str, says: &str| {
+            let e = Dialect::from_toml_str(toml).unwrap_err().to_string();
+            assert!(e.contains(says), "{toml}: {e}");
+        };
+        refused("contact_on = \"M60\"", "tow_restart: M60 is also the dialect's contact_on code");
+        refused("rapid = [\"G1\"]", "feed: G1 is also the dialect's rapid code");
+        refused("tow_cut = \"M21\"", "tow_cut: M21 is also the dialect's contact_off code");
+        refused("non_motion_codes = [\"G92\"]", "set_position: G92 is also the dialect's non_motion_codes code");
+        refused("rapid = [\"M20\"]", "rapid: M20 is not a G code");
+        refused("tow_restart = \"G60\"", "tow_restart: G60 is not an M code");
+        refused("feed_word = \"P\"", "tow_mask_word: P is also the feed_word");
+        refused("line_number_word = \"G\"", "line_number_word: G is the letter of G or M codes");
+        refused("course_comment = \"ply\"", "course_comment: \"ply\" is also the ply_comment");
+        // The same code twice in one role is harmless; G00 and G0 are one code.
+        assert!(Dialect::from_toml_str("rapid = [\"G0\", \"G00\"]").is_ok());
+        assert!(Dialect::from_toml_str("course_comment = \"\"").is_ok());
     }
 }
