@@ -263,6 +263,12 @@ fn bad_input_is_refused_with_the_line() {
     assert!(m.contains("no number"), "{m}");
     let (_, m) = err_line(&with("G1 X200 F3000", "G1 X200000000000 F3000"));
     assert!(m.contains("range"), "{m}");
+    // Exponent notation is not G-code: `X1e308` would read as X1 and a word E308.
+    let (l, m) = err_line(&with("G1 X200 F3000", "G1 X1e308 F3000"));
+    assert_eq!(l, 11);
+    assert!(m.contains("X1e308: exponent notation is not G-code (it reads as X1 and a word e308)"), "{m}");
+    let (_, m) = err_line(&with("G1 X200 F3000", "G1 X200 F3E3"));
+    assert!(m.contains("F3E3: exponent notation"), "{m}");
     let (_, m) = err_line(&with("M21\n", "M60 P1\nM21\n"));
     assert!(m.contains("tows still on"), "{m}");
     let (l, m) = err_line(&with("M60 P15\n", "M60 P15\nM60 P4\n"));
