@@ -186,7 +186,7 @@ impl MachineCost {
     }
 
     /// The cost of a move from `from` to `to` whose per-axis travel is `deltas` (which may differ
-    /// from `to − from` for axes that wrap).
+    /// from `to − from` for axes that wrap), at the axes' limits (a rapid move).
     pub fn segment(&self, from: &[f64], to: &[f64], deltas: &[f64]) -> Cost {
         match self.kind {
             CostKind::Axis => self.machine.weighted_distance(deltas),
@@ -195,6 +195,16 @@ impl MachineCost {
                 Some(k) => dist(k.part_point(from), k.part_point(to)),
                 None => 0.0,
             },
+        }
+    }
+
+    /// Like [`MachineCost::segment`] for a feed move at `feed` (mm/s, or deg/s for angular
+    /// axes alone; see [`Machine::feed_move_time`]): the time cost respects the feed, the
+    /// distance costs do not depend on it. `None` prices a rapid move.
+    pub fn segment_at(&self, from: &[f64], to: &[f64], deltas: &[f64], feed: Option<f64>) -> Cost {
+        match (self.kind, feed) {
+            (CostKind::Time, Some(f)) => self.machine.feed_move_time(deltas, f),
+            _ => self.segment(from, to, deltas),
         }
     }
 

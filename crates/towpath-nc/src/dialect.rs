@@ -55,6 +55,17 @@ pub enum EventTiming {
     After,
 }
 
+/// The unit of programmed feeds: per minute (ISO G-code: mm/min, or deg/min for a move of
+/// angular axes alone) or per second.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FeedUnit {
+    /// Units per minute (the default).
+    PerMinute,
+    /// Units per second.
+    PerSecond,
+}
+
 fn s(x: &str) -> String {
     x.to_string()
 }
@@ -83,6 +94,8 @@ pub struct Dialect {
     pub set_position: String,
     /// The feed-rate word letter.
     pub feed_word: String,
+    /// The unit of feed values: per minute (mm/min, deg/min) or per second.
+    pub feed_unit: FeedUnit,
     /// The line-number word letter (numbers are kept on the lines that have them).
     pub line_number_word: String,
     /// Roller contact on; empty when the machine has no contact codes (courses then run from
@@ -137,6 +150,7 @@ impl Default for Dialect {
             incremental: s("G91"),
             set_position: s("G92"),
             feed_word: s("F"),
+            feed_unit: FeedUnit::PerMinute,
             line_number_word: s("N"),
             contact_on: s("M20"),
             contact_off: s("M21"),
@@ -323,6 +337,14 @@ impl Dialect {
             )));
         }
         Ok(())
+    }
+
+    /// A programmed feed value in units per second.
+    pub fn feed_per_second(&self, feed: f64) -> f64 {
+        match self.feed_unit {
+            FeedUnit::PerMinute => feed / 60.0,
+            FeedUnit::PerSecond => feed,
+        }
     }
 
     /// Writes a comment in this dialect's style.

@@ -230,10 +230,10 @@ pub fn verify_parsed(
         inverse[i] = p.course;
     }
     let identity: Vec<usize> = (0..k).collect();
-    let before = measure(orig, machine, &identity, orig.header_end, orig.footer_start);
+    let before = measure(orig, machine, dialect, &identity, orig.header_end, orig.footer_start);
     // The optimized program starts with the original's header and ends with its footer.
     let footer_len = orig.lines.len() - orig.footer_start;
-    let after = measure(opt, machine, &inverse, orig.header_end, opt.lines.len() - footer_len);
+    let after = measure(opt, machine, dialect, &inverse, orig.header_end, opt.lines.len() - footer_len);
     Ok(Verification {
         courses: k,
         reversed: order.iter().filter(|p| p.reversed).count(),
@@ -866,10 +866,13 @@ fn check_sets(orig: &Program, fps: &Footprints, order: &[Placement]) -> Result<(
 
 /// Motion of a program under every cost model the machine supports; `course_of[c]` maps the
 /// program's course c to the index it is reported under. Lines before `header_end` and from
-/// `footer_start` count as header and footer.
+/// `footer_start` count as header and footer. Under the time cost a rapid move takes the axes'
+/// limits and a feed move its programmed feed (in the dialect's `feed_unit`, capped by the
+/// limits; see [`Machine::feed_move_time`]).
 pub fn measure(
     p: &Program,
     machine: &Machine,
+    dialect: &Dialect,
     course_of: &[usize],
     header_end: usize,
     footer_start: usize,
@@ -894,7 +897,8 @@ pub fn measure(
             for i in 0..d.len() {
                 d[i] = b[i] - a[i];
             }
-            let c = cost.segment(a, b, &d);
+            let feed = (!s.rapid).then(|| dialect.feed_per_second(s.feed));
+            let c = cost.segment_at(a, b, &d, feed);
             if s.on_part {
                 m.on_part += c;
                 continue;

@@ -145,7 +145,9 @@ fn program(spec: &PartSpec) -> String {
             }
             l.push(format!("M61 P{on}"));
             l.push("M21".into());
-            l.push("G1 Z20".into());
+            // Retracts of two heights, so that a reversed course's approach (the retract run
+            // backwards at the approach's feed) is not as long as its forward one.
+            l.push(if c.mask % 2 == 0 { "G1 Z20".into() } else { "G1 Z35".into() });
         }
     }
     l.push("G0 Z100".into());
@@ -225,6 +227,13 @@ proptest! {
         if !identity {
             let measured: f64 = a.off_course.iter().sum();
             prop_assert!((measured - route).abs() <= 1e-6 * (1.0 + route), "measured {} route {}", measured, route);
+            // Under the time cost too, where approach and retract moves run at their programmed
+            // feeds and a reversed course's approach takes the original approach's feed.
+            let timed = build_problem(&p, &m, &d, &AfpOptions { cost: CostKind::Time, ..opts.clone() }).unwrap();
+            let route = check(&timed.problem, &steps).unwrap();
+            let (_, a) = v.motion(CostKind::Time).unwrap();
+            let measured: f64 = a.off_course.iter().sum();
+            prop_assert!((measured - route).abs() <= 1e-6 * (1.0 + route), "time: measured {} route {}", measured, route);
         }
         // Every course reverses with the heading turned half a turn, but those holding an arc.
         for c in 0..p.courses.len() {
