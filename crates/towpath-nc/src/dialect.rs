@@ -66,6 +66,18 @@ pub enum FeedUnit {
     PerSecond,
 }
 
+/// A clearance for regenerated transits: the axis and the value they go to before moving the
+/// other axes (`clearance = { axis = "Z", value = 100.0 }`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Clearance {
+    /// The axis label, a linear axis of the machine (`"Z"`).
+    pub axis: String,
+    /// The axis value of the clearance, in program units (physical: set-position offsets
+    /// apply as for any move).
+    pub value: f64,
+}
+
 fn s(x: &str) -> String {
     x.to_string()
 }
@@ -136,6 +148,9 @@ pub struct Dialect {
     /// G codes whose axis words are not positions (a dwell `G4 X2`): such lines are kept as
     /// they are and move nothing.
     pub non_motion_codes: Vec<String>,
+    /// A clearance for the transits towpath writes: up to this value of this axis, across, and
+    /// down (none: one straight rapid move).
+    pub clearance: Option<Clearance>,
 }
 
 impl Default for Dialect {
@@ -169,6 +184,7 @@ impl Default for Dialect {
             course_width: None,
             decimals: 4,
             non_motion_codes: vec![s("G4")],
+            clearance: None,
         }
     }
 }
@@ -236,6 +252,14 @@ impl Dialect {
                 if !(w.is_finite() && w > 0.0) {
                     return Err(NcError::Dialect(format!("{k}: {w} is not a width > 0")));
                 }
+            }
+        }
+        if let Some(c) = &self.clearance {
+            if !(c.value.is_finite() && c.value.abs() <= crate::interp::MAX_AXIS_VALUE) {
+                return Err(NcError::Dialect(format!("clearance.value: {} is not a number within ±1e7", c.value)));
+            }
+            if c.axis.trim().is_empty() {
+                return Err(NcError::Dialect("clearance.axis: name the axis (a linear axis of the machine)".into()));
             }
         }
         if self.decimals > 9 {
@@ -339,6 +363,22 @@ impl Dialect {
         Ok(())
     }
 
+    /// The clearance of regenerated transits as (axis index, value) for this machine, if the
+    /// dialect sets one; refused unless the axis is a linear axis of the machine.
+    pub fn clearance_axis(&self, machine: &towpath_machine::Machine) -> Result<Option<(usize, f64)>, NcError> {
+        let Some(c) = &self.clearance else { return Ok(None) };
+        let Some(i) = machine.axis_index(c.axis.trim()) else {
+            return Err(NcError::Dialect(format!("clearance.axis: the machine has no axis {:?}", c.axis)));
+        };
+        if machine.axes[i].kind != towpath_machine::AxisKind::Linear {
+            return Err(NcError::Dialect(format!(
+                "clearance.axis: {} is not a linear axis (transits go up and down on a linear axis)",
+                machine.axes[i].label
+            )));
+        }
+        Ok(Some((i, c.value)))
+    }
+
     /// A programmed feed value in units per second.
     pub fn feed_per_second(&self, feed: f64) -> f64 {
         match self.feed_unit {
@@ -374,7 +414,12 @@ mod tests {
     #[test]
     fn every_key_is_documented_with_its_default() {
         let docs = include_str!("../../../docs/dialect.md");
-        let d = Dialect { tow_width: Some(1.0), course_width: Some(1.0), ..Dialect::default() };
+        let d = Dialect {
+            tow_width: Some(1.0),
+            course_width: Some(1.0),
+            clearance: Some(Clearance { axis: "Z".into(), value: 1.0 }),
+            ..Dialect::default()
+        };
         let toml::Value::Table(t) = toml::from_str::<toml::Value>(&d.to_toml_string()).unwrap() else {
             panic!("a dialect is a table")
         };

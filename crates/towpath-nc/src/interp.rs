@@ -153,6 +153,7 @@ impl<'a> Interp<'a> {
     /// An interpreter for a dialect and machine, starting at the machine's home state.
     pub fn new(dialect: &'a Dialect, machine: &Machine) -> Result<Self, NcError> {
         let codes = dialect.codes()?;
+        dialect.clearance_axis(machine)?;
         let reserved = [codes.feed_word, codes.line_number_word, codes.mask_word, 'G', 'M'];
         let mut letters = Vec::new();
         for a in &machine.axes {

@@ -172,7 +172,11 @@ pub fn build_problem(
         modes.push(m);
     }
     let end_state = footer_end(program, machine, dialect)?.map(|s| states.push(&s)).transpose()?;
-    let cost = MachineCost::new(machine.clone(), opts.cost, states)?;
+    let mut cost = MachineCost::new(machine.clone(), opts.cost, states)?;
+    if let Some((axis, value)) = dialect.clearance_axis(machine)? {
+        // The rewriter writes every transit by way of the clearance; the solver prices them so.
+        cost = cost.with_clearance(axis, value)?;
+    }
 
     let mut b = Problem::builder(cost.clone());
     for (c, ms) in modes.iter().enumerate() {

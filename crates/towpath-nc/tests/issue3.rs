@@ -813,3 +813,59 @@ fn motion_time_respects_programmed_feeds() {
         assert!((axis.on_part - 300.0).abs() < 1e-9 && (axis.off_course[0] - 175.0).abs() < 1e-9, "{axis:?}");
     }
 }
+
+/// `clearance = { axis = "Z", value = 50 }`: every transit towpath writes goes up to Z50, moves
+/// the other axes there, and comes down to where the next course's approach starts; X, Y and C
+/// never move below the clearance between courses. The optimized program verifies, and its
+/// measured off-part motion is what the solver priced.
+#[test]
+fn transits_go_by_way_of_the_clearance() {
+    let text = program();
+    let d = Dialect { clearance: Some(towpath_nc::Clearance { axis: "z".into(), value: 50.0 }), ..Dialect::default() };
+    let o = optimize(&text, &gantry(), &d, &opts(true)).unwrap();
+    assert!(!o.fell_back && o.order.iter().enumerate().any(|(i, p)| p.course != i || p.reversed));
+    let out = parse(&o.text, &gantry(), &d).unwrap();
+    let regions = out.regions();
+    let mut transit_moves = vec![0; out.courses.len()];
+    for s in &out.segments {
+        let towpath_nc::Region::Middle(k) = regions[s.line as usize] else { continue };
+        transit_moves[k] += 1;
+        let (a, b) = (out.point(s.from), out.point(s.to));
+        let sideways = (0..4).any(|i| i != 2 && (a[i] - b[i]).abs() > 1e-9);
+        if sideways {
+            assert!(a[2] == 50.0 && b[2] == 50.0, "line {}: {:?} -> {:?}", s.line + 1, a, b);
+        }
+        assert!(s.rapid, "line {}", s.line + 1);
+    }
+    // Up, across, down: three moves (one, straight down, where only Z changes).
+    assert!(transit_moves.iter().all(|&n| n == 1 || n == 3), "{transit_moves:?}\n{}", o.text);
+    assert!(transit_moves.iter().filter(|&&n| n == 3).count() >= 4, "{transit_moves:?}\n{}", o.text);
+    let (before, after) = o.verification.motion(CostKind::Axis).unwrap();
+    assert!(after.off_part() <= before.off_part());
+    let measured: f64 = after.off_course.iter().sum();
+    let route = towpath_seq::check(
+        &o.afp.problem,
+        &o.order
+            .iter()
+            .map(|p| towpath_seq::Step { task: towpath_seq::TaskId(p.course as u32), mode: p.reversed as u32 })
+            .collect::<Vec<_>>(),
+    )
+    .unwrap();
+    assert!((measured - route).abs() < 1e-6, "measured {measured}, solver {route}");
+    verify(&text, &o.text, &gantry(), &d, &vopts()).unwrap();
+    // The clearance axis must be a linear axis of the machine.
+    for (axis, says) in
+        [("Q", "clearance.axis: the machine has no axis \"Q\""), ("C", "clearance.axis: C is not a linear axis")]
+    {
+        let d =
+            Dialect { clearance: Some(towpath_nc::Clearance { axis: axis.into(), value: 50.0 }), ..Dialect::default() };
+        let e = parse(&text, &gantry(), &d).unwrap_err().to_string();
+        assert!(e.contains(says), "{e}");
+    }
+    let e = Dialect::from_toml_str("clearance = { axis = \"Z\", value = nan }").unwrap_err().to_string();
+    assert!(e.contains("clearance.value"), "{e}");
+    let e = Dialect::from_toml_str("clearance = { axis = \"Z\", height = 50.0 }").unwrap_err().to_string();
+    assert!(e.contains("unknown field `height`"), "{e}");
+    let d = Dialect::from_toml_str("clearance = { axis = \"Z\", value = 50.0 }").unwrap();
+    assert_eq!(Dialect::from_toml_str(&d.to_toml_string()).unwrap(), d);
+}
