@@ -135,6 +135,23 @@ fn bad_input_names_file_and_line() {
         .arg(d.join("o.nc")));
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("m.toml") && err.contains("line 4"), "{err}");
+    // A dialect that does not fit the machine names both files, not the program's first line.
+    let dialect = d.join("clash.toml");
+    std::fs::write(&dialect, "[clearance]\naxis = \"C\"\nvalue = 100.0\n").unwrap();
+    let (code, _, err) = run(towpath()
+        .arg("verify")
+        .arg(d.join("planar-0.nc"))
+        .arg(d.join("planar-0.nc"))
+        .arg("--machine")
+        .arg(d.join("gantry-afp.toml"))
+        .arg("--dialect")
+        .arg(&dialect));
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("gantry-afp.toml with")
+            && err.contains("clash.toml: dialect: clearance.axis: C is not a linear axis"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -37,6 +37,15 @@ impl MachineArgs {
             }
             None => Dialect::default(),
         };
+        // The two files must fit each other (axis labels against the dialect's words, the
+        // clearance axis): said here, naming both, rather than at the program's first line.
+        if let Err(e) = towpath_nc::Interp::new(&dialect, &machine) {
+            let files = match &self.dialect {
+                Some(d) => format!("{} with {}", self.machine.display(), d.display()),
+                None => format!("{} with the reference dialect", self.machine.display()),
+            };
+            return Err(exit::bad_input(anyhow::anyhow!("{files}: {e}")));
+        }
         let width = match (self.tow_width, self.course_width) {
             (Some(w), _) => Some(Width::Tow(positive("--tow-width", w)?)),
             (_, Some(w)) => Some(Width::Course(positive("--course-width", w)?)),
