@@ -258,6 +258,18 @@ fn bad_input_is_refused_with_the_line() {
     assert!(m.contains("never closed"), "{m}");
     // The M20 of the appended course: the line that opened it.
     assert_eq!(l, good.lines().count() + 2);
+    // A course whose lift is missing runs into a footer line towpath cannot read inside a
+    // course: the message names the course's opening line too.
+    let lifts: Vec<usize> = good.lines().enumerate().filter(|(_, l)| *l == "M21").map(|(i, _)| i).collect();
+    let last_lift = *lifts.last().unwrap();
+    let opened = good.lines().take(last_lift).enumerate().filter(|(_, l)| *l == "M20").map(|(i, _)| i).last().unwrap();
+    let cut: Vec<&str> = good.lines().enumerate().filter(|(i, _)| *i != last_lift).map(|(_, l)| l).collect();
+    let (l, m) = err_line(&(cut.join("\n") + "\n"));
+    assert_eq!(l, good.lines().count() - 1, "{m}");
+    assert!(
+        m.contains(&format!("inside the course opened at line {}", opened + 1)) && m.contains("M21 is missing"),
+        "{m}"
+    );
     let (l, m) = err_line(&with("G1 X200 F3000", "G1 Xnan F3000"));
     assert_eq!(l, 11);
     assert!(m.contains("no number"), "{m}");
