@@ -135,6 +135,22 @@ fn bad_input_names_file_and_line() {
         .arg(d.join("o.nc")));
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("m.toml") && err.contains("line 4"), "{err}");
+    // Text that is not UTF-8 (a Latin-1 degree sign in a comment): the line and byte.
+    let latin1 = d.join("latin1.nc");
+    let mut bytes = text.as_bytes().to_vec();
+    let at = text.find("(PLY 2").unwrap() + 4;
+    bytes.insert(at, 0xb0);
+    std::fs::write(&latin1, &bytes).unwrap();
+    let line = text[..at].matches('\n').count() + 1;
+    let (code, _, err) = run(towpath()
+        .arg("optimize")
+        .arg(&latin1)
+        .arg("--machine")
+        .arg(d.join("gantry-afp.toml"))
+        .arg("-o")
+        .arg(d.join("o.nc")));
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains(&format!("latin1.nc: line {line}: byte 5 (0xb0) is not UTF-8")), "{err}");
     // A dialect that does not fit the machine names both files, not the program's first line.
     let dialect = d.join("clash.toml");
     std::fs::write(&dialect, "[clearance]\naxis = \"C\"\nvalue = 100.0\n").unwrap();

@@ -63,9 +63,22 @@ fn positive(name: &str, w: f64) -> anyhow::Result<f64> {
     }
 }
 
-/// Reads a text file, naming it on failure.
+/// Reads a text file, naming it on failure (for text that is not UTF-8, the line and byte).
 pub fn read(path: &Path) -> anyhow::Result<String> {
-    std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display())).map_err(exit::bad_input)
+    let bytes =
+        std::fs::read(path).with_context(|| format!("{}: cannot read", path.display())).map_err(exit::bad_input)?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+        let column = at - bytes[..at].iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1) + 1;
+        exit::bad_input(anyhow::anyhow!(
+            "{}: line {line}: byte {column} (0x{:02x}) is not UTF-8 text; towpath reads UTF-8 (ASCII) programs and \
+             copies their lines byte for byte, so it does not guess another encoding",
+            path.display(),
+            bytes[at]
+        ))
+    })
 }
 
 /// Reads and validates a machine file.
