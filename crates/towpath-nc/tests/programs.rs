@@ -200,6 +200,36 @@ fn verifier_catches_illegal_reversals() {
     assert!(e.to_string().contains("axis C"), "{e}");
 }
 
+/// Approach and retract moves keep their motion code and feed, forward and reversed (the
+/// reversed approach takes the original approach's): a roller brought down at a rapid, or at
+/// another feed, is refused even though the laid motion is the same.
+#[test]
+fn verifier_catches_an_approach_at_a_rapid_or_another_feed() {
+    let d = Dialect::default();
+    let (orig, out) = optimized(false);
+    verify(&orig, &out, &gantry(), &d, &vopts()).unwrap();
+    for broken in [
+        out.replacen("G1 Z0 F1000\nM20\n", "G0 Z0\nG1 F1000\nM20\n", 1),
+        out.replacen("G1 Z0 F1000\nM20\n", "G1 Z0 F9000\nM20\n", 1),
+    ] {
+        assert_ne!(broken, out);
+        let e = verify(&orig, &broken, &gantry(), &d, &vopts()).unwrap_err();
+        assert!(matches!(e, VerifyError::Unmatched { .. }), "{e}");
+        assert!(e.to_string().contains("(off-part)"), "{e}");
+    }
+    // Course 1 first and reversed: its approach (the original retract run backwards) must take
+    // the original approach's G1 F1000.
+    let p = parse(&orig, &gantry(), &d).unwrap();
+    let rev: Vec<_> = (0..p.courses.len()).map(|c| reverse_course(&p, c, &gantry(), &d).ok()).collect();
+    let order: Vec<Placement> = (0..5).map(|c| Placement { course: c, reversed: c == 0 }).collect::<Vec<_>>();
+    let good = rewrite(&p, &order, &gantry(), &d, &rev).unwrap();
+    verify(&orig, &good, &gantry(), &d, &vopts()).unwrap();
+    let plunge = good.replacen("G1 Z0 F1000\nM20\nM60 P12\n", "G0 Z0\nG1\nM20\nM60 P12\n", 1);
+    assert_ne!(plunge, good);
+    let e = verify(&orig, &plunge, &gantry(), &d, &vopts()).unwrap_err();
+    assert!(e.to_string().contains("a rapid instead of feed 1000"), "{e}");
+}
+
 #[test]
 fn precedence_needs_a_width_and_says_so() {
     let d = Dialect::default();
