@@ -81,6 +81,9 @@ pub enum CostError {
     /// A state value is not finite.
     #[error("state value {0} is not finite")]
     NotFinite(f64),
+    /// The clearance axis or value cannot be used.
+    #[error("clearance: {0}")]
+    Clearance(String),
 }
 
 /// A table of machine states (axis vectors of one length), addressed by [`StateId`].
@@ -143,6 +146,8 @@ pub struct MachineCost {
     kin: Option<Kinematics>,
     states: StateTable,
     points: Vec<[f64; 3]>,
+    /// Transits go by way of this value of this (linear) axis; see [`MachineCost::with_clearance`].
+    clearance: Option<(usize, f64)>,
 }
 
 impl MachineCost {
@@ -167,7 +172,30 @@ impl MachineCost {
             Some(k) => (0..states.len()).map(|i| k.part_point(states.get(StateId(i as u32)))).collect(),
             None => Vec::new(),
         };
-        Ok(MachineCost { machine, kind, kin, states, points })
+        Ok(MachineCost { machine, kind, kin, states, points, clearance: None })
+    }
+
+    /// Transitions by way of a clearance value of linear axis `axis`: a transition that moves
+    /// any other axis goes to `value` on that axis first, then moves the other axes, then goes
+    /// to its target's value (three moves, each priced as a direct move); one that moves only
+    /// that axis stays a direct move. The model stays symmetric and obeys the triangle
+    /// inequality.
+    pub fn with_clearance(mut self, axis: usize, value: f64) -> Result<Self, CostError> {
+        match self.machine.axes.get(axis) {
+            None => return Err(CostError::Clearance(format!("the machine has no axis {axis}"))),
+            Some(a) if a.kind != crate::AxisKind::Linear => {
+                return Err(CostError::Clearance(format!("axis {} is not a linear axis", a.label)))
+            }
+            Some(_) if !value.is_finite() => return Err(CostError::Clearance(format!("{value} is not finite"))),
+            Some(_) => {}
+        }
+        self.clearance = Some((axis, value));
+        Ok(self)
+    }
+
+    /// The clearance axis and value, if transitions go by way of one.
+    pub fn clearance(&self) -> Option<(usize, f64)> {
+        self.clearance
     }
 
     /// The machine.
@@ -186,7 +214,7 @@ impl MachineCost {
     }
 
     /// The cost of a move from `from` to `to` whose per-axis travel is `deltas` (which may differ
-    /// from `to − from` for axes that wrap).
+    /// from `to − from` for axes that wrap), at the axes' limits (a rapid move).
     pub fn segment(&self, from: &[f64], to: &[f64], deltas: &[f64]) -> Cost {
         match self.kind {
             CostKind::Axis => self.machine.weighted_distance(deltas),
@@ -198,8 +226,35 @@ impl MachineCost {
         }
     }
 
-    /// The cost of the shortest direct move between two states (wrapping axes the short way).
+    /// Like [`MachineCost::segment`] for a feed move at `feed` (mm/s, or deg/s for angular
+    /// axes alone; see [`Machine::feed_move_time`]): the time cost respects the feed, the
+    /// distance costs do not depend on it. `None` prices a rapid move.
+    pub fn segment_at(&self, from: &[f64], to: &[f64], deltas: &[f64], feed: Option<f64>) -> Cost {
+        match (self.kind, feed) {
+            (CostKind::Time, Some(f)) => self.machine.feed_move_time(deltas, f),
+            _ => self.segment(from, to, deltas),
+        }
+    }
+
+    /// The cost of a transition between two states: the shortest direct move (wrapping axes the
+    /// short way), or with a clearance ([`MachineCost::with_clearance`]) the three moves by way
+    /// of it when an axis other than the clearance axis moves.
     pub fn between(&self, from: &[f64], to: &[f64]) -> Cost {
+        if let Some((z, h)) = self.clearance {
+            let others_move =
+                (0..from.len()).any(|i| i != z && self.machine.short_delta(i, from[i], to[i]).abs() > 1e-9);
+            if others_move {
+                let (mut up, mut over) = (from.to_vec(), to.to_vec());
+                up[z] = h;
+                over[z] = h;
+                return self.direct(from, &up) + self.direct(&up, &over) + self.direct(&over, to);
+            }
+        }
+        self.direct(from, to)
+    }
+
+    /// The cost of the shortest direct move between two states (wrapping axes the short way).
+    pub fn direct(&self, from: &[f64], to: &[f64]) -> Cost {
         match self.kind {
             CostKind::Tool => self.segment(from, to, &[]),
             _ => {
@@ -229,7 +284,7 @@ impl CostModel for MachineCost {
 
     #[inline]
     fn cost(&self, from: StateId, to: StateId) -> Cost {
-        if self.kind == CostKind::Tool {
+        if self.kind == CostKind::Tool && self.clearance.is_none() {
             return dist(self.points[from.index()], self.points[to.index()]);
         }
         self.between(self.states.get(from), self.states.get(to))
@@ -295,6 +350,25 @@ mod tests {
         assert!(t.push(&[1.0, f64::NAN]).is_err());
     }
 
+    /// With a clearance on Y (at 150), a transition that moves X or the mandrel goes up, across
+    /// and down; one that moves Y alone stays direct.
+    #[test]
+    fn clearance_transits_go_up_across_and_down() {
+        let mut t = StateTable::new(3);
+        let s0 = t.push(&[0.0, 100.0, 0.0]).unwrap();
+        let s1 = t.push(&[40.0, 120.0, 0.0]).unwrap();
+        let s2 = t.push(&[0.0, 20.0, 0.0]).unwrap();
+        let c = MachineCost::new(machine(), CostKind::Axis, t.clone()).unwrap().with_clearance(1, 150.0).unwrap();
+        // Up 50 (weight 0.5), across 40, down 30 (weight 0.5).
+        assert_eq!(c.cost(s0, s1), 25.0 + 40.0 + 15.0);
+        assert_eq!(c.cost(s1, s0), 80.0);
+        assert_eq!(c.cost(s0, s2), 0.5 * 80.0);
+        let tool = MachineCost::new(machine(), CostKind::Tool, t).unwrap().with_clearance(1, 150.0).unwrap();
+        assert!((tool.cost(s0, s1) - 120.0).abs() < 1e-9);
+        let e = MachineCost::new(machine(), CostKind::Axis, StateTable::new(3)).unwrap().with_clearance(2, 1.0);
+        assert_eq!(e.unwrap_err().to_string(), "clearance: axis A is not a linear axis");
+    }
+
     #[test]
     fn tool_cost_in_the_part_frame() {
         let mut t = StateTable::new(3);
@@ -315,13 +389,16 @@ mod tests {
         ) {
             let mut t = StateTable::new(3);
             let (sa, sb, sc) = (t.push(&a).unwrap(), t.push(&b).unwrap(), t.push(&c).unwrap());
-            for kind in CostKind::ALL {
-                let m = MachineCost::new(machine(), kind, t.clone()).unwrap();
+            for (kind, clearance) in CostKind::ALL.into_iter().flat_map(|k| [(k, None), (k, Some(150.0))]) {
+                let mut m = MachineCost::new(machine(), kind, t.clone()).unwrap();
+                if let Some(h) = clearance {
+                    m = m.with_clearance(1, h).unwrap();
+                }
                 let ab = m.cost(sa, sb);
                 prop_assert!((ab - m.cost(sb, sa)).abs() <= 1e-9 * (1.0 + ab));
                 // Direct moves are never dearer than going through a third state: the
                 // rewriter relies on this when it replaces a transit by one move.
-                prop_assert!(ab <= m.cost(sa, sc) + m.cost(sc, sb) + 1e-9 * (1.0 + ab), "{kind}");
+                prop_assert!(ab <= m.cost(sa, sc) + m.cost(sc, sb) + 1e-9 * (1.0 + ab), "{kind} {clearance:?}");
                 prop_assert!(m.cost(sa, sa).abs() < 1e-12);
             }
         }

@@ -1,5 +1,6 @@
 //! Motion of single moves: the trapezoidal velocity profile of one axis, and the weighted axis
-//! distance and simultaneous-axes time of a move whose per-axis travel is known.
+//! distance and simultaneous-axes time of a move whose per-axis travel is known, at the axes'
+//! limits (a rapid) or at a programmed feed.
 
 use crate::config::Machine;
 
@@ -45,6 +46,49 @@ impl Machine {
         t
     }
 
+    /// The path length a programmed feed applies to (the RS274/NGC rule): the straight-line
+    /// length of the linear axes' travel when any linear axis moves (angular axes then move in
+    /// step with them), else the straight-line length of the angular axes' travel, in degrees.
+    pub fn feed_length(&self, deltas: &[f64]) -> f64 {
+        let (mut linear, mut angular) = (0.0f64, 0.0f64);
+        for (a, d) in self.axes.iter().zip(deltas) {
+            if a.kind.is_angular() {
+                angular += d * d;
+            } else {
+                linear += d * d;
+            }
+        }
+        if linear > 0.0 {
+            linear.sqrt()
+        } else {
+            angular.sqrt()
+        }
+    }
+
+    /// Time of a feed move with these per-axis travels at a programmed feed of `feed` (mm/s,
+    /// or deg/s for a move of angular axes alone; see [`Machine::feed_length`]), all axes
+    /// starting and stopping together: each axis moves on a trapezoidal profile whose cruise
+    /// speed is its share of the feed, `feed · |Δa| / length`, capped by its `max_velocity`; the
+    /// move takes the slowest axis's time. Without an acceleration limit and below every
+    /// velocity limit this is `length / feed`. A feed that is not a positive number is ignored
+    /// (the move is timed like a rapid, [`Machine::move_time`]).
+    pub fn feed_move_time(&self, deltas: &[f64], feed: f64) -> f64 {
+        let length = self.feed_length(deltas);
+        if !(feed > 0.0 && feed.is_finite()) || length == 0.0 {
+            return self.move_time(deltas);
+        }
+        let mut t: f64 = 0.0;
+        for (a, d) in self.axes.iter().zip(deltas) {
+            if *d == 0.0 {
+                continue;
+            }
+            let share = feed * d.abs() / length;
+            let v = a.max_velocity.map_or(share, |m| m.min(share));
+            t = t.max(trapezoid_time(*d, v, a.max_acceleration));
+        }
+        t
+    }
+
     /// The axes a time cost cannot price: those without `max_velocity`.
     pub fn axes_without_velocity(&self) -> Vec<&str> {
         self.axes.iter().filter(|a| a.max_velocity.is_none()).map(|a| a.label.as_str()).collect()
@@ -80,5 +124,35 @@ mod tests {
         assert_eq!(m.move_time(&[100.0, 5.0]), 1.0);
         assert_eq!(m.move_time(&[10.0, -20.0]), 2.0);
         assert_eq!(m.weighted_distance(&[10.0, -20.0]), 40.0);
+    }
+
+    /// Feed moves, timed by hand: the feed sets each axis's cruise speed (its share of the
+    /// path), acceleration ramps included; angular axes alone take the feed in degrees.
+    #[test]
+    fn feed_moves_take_their_programmed_feed() {
+        let mut x = Axis::new("X", AxisKind::Linear);
+        (x.max_velocity, x.max_acceleration) = (Some(1000.0), Some(2000.0));
+        let mut y = Axis::new("Y", AxisKind::Linear);
+        (y.max_velocity, y.max_acceleration) = (Some(1000.0), Some(2000.0));
+        let mut c = Axis::new("C", AxisKind::Continuous);
+        (c.max_velocity, c.max_acceleration) = (Some(180.0), Some(720.0));
+        let m = Machine::new("m", vec![x, y, c]).unwrap();
+        // 300 mm at 100 mm/s: 3 s cruising plus 100/2000 s of ramps (at the machine's limits it
+        // never reaches full speed: 2·√(300/2000) s).
+        assert!((m.feed_move_time(&[300.0, 0.0, 0.0], 100.0) - 3.05).abs() < 1e-12);
+        assert!((m.move_time(&[300.0, 0.0, 0.0]) - 2.0 * 0.15f64.sqrt()).abs() < 1e-12);
+        // A 3-4-5 move at 50 mm/s: X cruises at 30 mm/s, Y at 40; Y is slower (5 + 0.02 s).
+        assert_eq!(m.feed_length(&[30.0, 40.0, 10.0]), 50.0);
+        assert!((m.feed_move_time(&[150.0, 200.0, 0.0], 50.0) - (200.0 / 40.0 + 40.0 / 2000.0)).abs() < 1e-12);
+        // C alone: 90° at 30°/s, 3 s plus 30/720 s.
+        assert_eq!(m.feed_length(&[0.0, 0.0, -90.0]), 90.0);
+        assert!((m.feed_move_time(&[0.0, 0.0, -90.0], 30.0) - (3.0 + 30.0 / 720.0)).abs() < 1e-12);
+        // X 100 mm at 100 mm/s with C turning 90° in step: C's share is 90°/s (under its 180),
+        // 1 + 90/720 s, slower than X's 1 + 100/2000 s.
+        assert!((m.feed_move_time(&[100.0, 0.0, 90.0], 100.0) - 1.125).abs() < 1e-12);
+        // A feed faster than the machine: the velocity limits rule, as for a rapid.
+        assert_eq!(m.feed_move_time(&[300.0, 0.0, 0.0], 1e6), m.move_time(&[300.0, 0.0, 0.0]));
+        assert_eq!(m.feed_move_time(&[300.0, 0.0, 0.0], f64::NAN), m.move_time(&[300.0, 0.0, 0.0]));
+        assert_eq!(m.feed_move_time(&[0.0, 0.0, 0.0], 100.0), 0.0);
     }
 }

@@ -255,7 +255,8 @@ fn main() {
     ));
     md.push_str(
         "\nThe time column optimizes `--cost time` instead and measures motion time (all axes together, \
-         trapezoidal profiles, the demo machines' limits): time savings are smaller than distance savings \
+         trapezoidal profiles; rapids at the demo machines' limits, feed moves at their programmed feed, \
+         docs/machine.md): time savings are smaller than distance savings \
          because every reversal turns the head 180° (1.25 s on these machines) and approach and retract \
          take the same time whatever the order; optimizing the axis distance can even lengthen the \
          off-part time.\n",

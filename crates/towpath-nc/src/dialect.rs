@@ -55,6 +55,29 @@ pub enum EventTiming {
     After,
 }
 
+/// The unit of programmed feeds: per minute (ISO G-code: mm/min, or deg/min for a move of
+/// angular axes alone) or per second.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FeedUnit {
+    /// Units per minute (the default).
+    PerMinute,
+    /// Units per second.
+    PerSecond,
+}
+
+/// A clearance for regenerated transits: the axis and the value they go to before moving the
+/// other axes (`clearance = { axis = "Z", value = 100.0 }`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Clearance {
+    /// The axis label, a linear axis of the machine (`"Z"`).
+    pub axis: String,
+    /// The axis value of the clearance, in program units (physical: set-position offsets
+    /// apply as for any move).
+    pub value: f64,
+}
+
 fn s(x: &str) -> String {
     x.to_string()
 }
@@ -83,6 +106,8 @@ pub struct Dialect {
     pub set_position: String,
     /// The feed-rate word letter.
     pub feed_word: String,
+    /// The unit of feed values: per minute (mm/min, deg/min) or per second.
+    pub feed_unit: FeedUnit,
     /// The line-number word letter (numbers are kept on the lines that have them).
     pub line_number_word: String,
     /// Roller contact on; empty when the machine has no contact codes (courses then run from
@@ -123,6 +148,9 @@ pub struct Dialect {
     /// G codes whose axis words are not positions (a dwell `G4 X2`): such lines are kept as
     /// they are and move nothing.
     pub non_motion_codes: Vec<String>,
+    /// A clearance for the transits towpath writes: up to this value of this axis, across, and
+    /// down (none: one straight rapid move).
+    pub clearance: Option<Clearance>,
 }
 
 impl Default for Dialect {
@@ -137,6 +165,7 @@ impl Default for Dialect {
             incremental: s("G91"),
             set_position: s("G92"),
             feed_word: s("F"),
+            feed_unit: FeedUnit::PerMinute,
             line_number_word: s("N"),
             contact_on: s("M20"),
             contact_off: s("M21"),
@@ -155,6 +184,7 @@ impl Default for Dialect {
             course_width: None,
             decimals: 4,
             non_motion_codes: vec![s("G4")],
+            clearance: None,
         }
     }
 }
@@ -224,6 +254,14 @@ impl Dialect {
                 }
             }
         }
+        if let Some(c) = &self.clearance {
+            if !(c.value.is_finite() && c.value.abs() <= crate::interp::MAX_AXIS_VALUE) {
+                return Err(NcError::Dialect(format!("clearance.value: {} is not a number within ±1e7", c.value)));
+            }
+            if c.axis.trim().is_empty() {
+                return Err(NcError::Dialect("clearance.axis: name the axis (a linear axis of the machine)".into()));
+            }
+        }
         if self.decimals > 9 {
             return Err(NcError::Dialect(format!("decimals: {} is more than 9", self.decimals)));
         }
@@ -243,7 +281,7 @@ impl Dialect {
                 planes.len()
             )));
         }
-        Ok(Codes {
+        let codes = Codes {
             rapid: list("rapid", &self.rapid)?,
             feed: list("feed", &self.feed)?,
             arc_cw: any("arc_cw", &self.arc_cw)?,
@@ -258,7 +296,95 @@ impl Dialect {
             restart: code("tow_restart", &self.tow_restart)?,
             cut: code("tow_cut", &self.tow_cut)?,
             mask_word: letter("tow_mask_word", &self.tow_mask_word)?,
-        })
+        };
+        self.check_roles(&codes)?;
+        Ok(codes)
+    }
+
+    /// Every code has one role and the letter the interpreter reads it with (motion and mode
+    /// codes are G codes, contact and tow codes M codes); the word letters differ from each
+    /// other and from G and M; ply and course comments differ.
+    fn check_roles(&self, c: &Codes) -> Result<(), NcError> {
+        let non_motion = self
+            .non_motion_codes
+            .iter()
+            .map(|x| {
+                Code::parse(x).ok_or_else(|| NcError::Dialect(format!("non_motion_codes: {x:?} is not a code like G4")))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut roles: Vec<(&str, Code, char)> = Vec::new();
+        for (key, list) in [
+            ("rapid", &c.rapid),
+            ("feed", &c.feed),
+            ("arc_cw", &c.arc_cw),
+            ("arc_ccw", &c.arc_ccw),
+            ("arc_planes", &c.planes),
+            ("non_motion_codes", &non_motion),
+        ] {
+            roles.extend(list.iter().map(|&x| (key, x, 'G')));
+        }
+        roles.push(("absolute", c.absolute, 'G'));
+        roles.push(("incremental", c.incremental, 'G'));
+        roles.push(("set_position", c.set_position, 'G'));
+        if let Some((on, off)) = c.contact {
+            roles.push(("contact_on", on, 'M'));
+            roles.push(("contact_off", off, 'M'));
+        }
+        roles.push(("tow_restart", c.restart, 'M'));
+        roles.push(("tow_cut", c.cut, 'M'));
+        for (i, &(key, x, letter)) in roles.iter().enumerate() {
+            if x.letter != letter {
+                let article = if letter == 'M' { "an" } else { "a" };
+                return Err(NcError::Dialect(format!(
+                    "{key}: {x} is not {article} {letter} code (motion and mode codes are G codes, contact and tow codes M codes)"
+                )));
+            }
+            let same = |&&(k, y, _): &&(&str, Code, char)| k != key && y == x;
+            if let Some((other, ..)) = roles[..i].iter().find(same) {
+                return Err(NcError::Dialect(format!("{key}: {x} is also the dialect's {other} code")));
+            }
+        }
+        let words =
+            [("feed_word", c.feed_word), ("line_number_word", c.line_number_word), ("tow_mask_word", c.mask_word)];
+        for (i, &(key, l)) in words.iter().enumerate() {
+            if l == 'G' || l == 'M' {
+                return Err(NcError::Dialect(format!("{key}: {l} is the letter of G or M codes")));
+            }
+            if let Some((other, _)) = words[..i].iter().find(|w| w.1 == l) {
+                return Err(NcError::Dialect(format!("{key}: {l} is also the {other}")));
+            }
+        }
+        if self.ply_comment.trim().eq_ignore_ascii_case(self.course_comment.trim()) {
+            return Err(NcError::Dialect(format!(
+                "course_comment: {:?} is also the ply_comment: give courses another word (or \"\")",
+                self.course_comment
+            )));
+        }
+        Ok(())
+    }
+
+    /// The clearance of regenerated transits as (axis index, value) for this machine, if the
+    /// dialect sets one; refused unless the axis is a linear axis of the machine.
+    pub fn clearance_axis(&self, machine: &towpath_machine::Machine) -> Result<Option<(usize, f64)>, NcError> {
+        let Some(c) = &self.clearance else { return Ok(None) };
+        let Some(i) = machine.axis_index(c.axis.trim()) else {
+            return Err(NcError::Dialect(format!("clearance.axis: the machine has no axis {:?}", c.axis)));
+        };
+        if machine.axes[i].kind != towpath_machine::AxisKind::Linear {
+            return Err(NcError::Dialect(format!(
+                "clearance.axis: {} is not a linear axis (transits go up and down on a linear axis)",
+                machine.axes[i].label
+            )));
+        }
+        Ok(Some((i, c.value)))
+    }
+
+    /// A programmed feed value in units per second.
+    pub fn feed_per_second(&self, feed: f64) -> f64 {
+        match self.feed_unit {
+            FeedUnit::PerMinute => feed / 60.0,
+            FeedUnit::PerSecond => feed,
+        }
     }
 
     /// Writes a comment in this dialect's style.
@@ -288,7 +414,12 @@ mod tests {
     #[test]
     fn every_key_is_documented_with_its_default() {
         let docs = include_str!("../../../docs/dialect.md");
-        let d = Dialect { tow_width: Some(1.0), course_width: Some(1.0), ..Dialect::default() };
+        let d = Dialect {
+            tow_width: Some(1.0),
+            course_width: Some(1.0),
+            clearance: Some(Clearance { axis: "Z".into(), value: 1.0 }),
+            ..Dialect::default()
+        };
         let toml::Value::Table(t) = toml::from_str::<toml::Value>(&d.to_toml_string()).unwrap() else {
             panic!("a dialect is a table")
         };
@@ -326,5 +457,29 @@ mod tests {
         assert!(e.to_string().contains("both"), "{e}");
         let e = Dialect::from_toml_str("tow_width = -3.0").unwrap_err();
         assert!(e.to_string().contains("tow_width"), "{e}");
+    }
+
+    /// A code with two roles, a code with the wrong letter (the interpreter reads motion and mode
+    /// codes only as G words, contact and tow codes only as M words), clashing word letters and
+    /// one marker word for plies and courses are refused with the key, not left to misread
+    /// programs.
+    #[test]
+    fn codes_with_two_roles_or_the_wrong_letter_are_refused() {
+        let refused = |toml: &str, says: &str| {
+            let e = Dialect::from_toml_str(toml).unwrap_err().to_string();
+            assert!(e.contains(says), "{toml}: {e}");
+        };
+        refused("contact_on = \"M60\"", "tow_restart: M60 is also the dialect's contact_on code");
+        refused("rapid = [\"G1\"]", "feed: G1 is also the dialect's rapid code");
+        refused("tow_cut = \"M21\"", "tow_cut: M21 is also the dialect's contact_off code");
+        refused("non_motion_codes = [\"G92\"]", "set_position: G92 is also the dialect's non_motion_codes code");
+        refused("rapid = [\"M20\"]", "rapid: M20 is not a G code");
+        refused("tow_restart = \"G60\"", "tow_restart: G60 is not an M code");
+        refused("feed_word = \"P\"", "tow_mask_word: P is also the feed_word");
+        refused("line_number_word = \"G\"", "line_number_word: G is the letter of G or M codes");
+        refused("course_comment = \"ply\"", "course_comment: \"ply\" is also the ply_comment");
+        // The same code twice in one role is harmless; G00 and G0 are one code.
+        assert!(Dialect::from_toml_str("rapid = [\"G0\", \"G00\"]").is_ok());
+        assert!(Dialect::from_toml_str("course_comment = \"\"").is_ok());
     }
 }

@@ -153,6 +153,7 @@ impl<'a> Interp<'a> {
     /// An interpreter for a dialect and machine, starting at the machine's home state.
     pub fn new(dialect: &'a Dialect, machine: &Machine) -> Result<Self, NcError> {
         let codes = dialect.codes()?;
+        dialect.clearance_axis(machine)?;
         let reserved = [codes.feed_word, codes.line_number_word, codes.mask_word, 'G', 'M'];
         let mut letters = Vec::new();
         for a in &machine.axes {
@@ -224,6 +225,28 @@ impl<'a> Interp<'a> {
                 return Ok(Applied { unknown: true, ..Applied::default() });
             }
         };
+        // `X1e308` or `F1.5E3`: a number in exponent notation, which G-code does not have (the
+        // words read as X1 and E308). Refused rather than read as something else.
+        if self.axis_of('E').is_none() {
+            for w in lexed.words.windows(2) {
+                let (a, b) = (&w[0], &w[1]);
+                if b.letter == 'E'
+                    && b.span.start == a.span.end
+                    && (self.axis_of(a.letter).is_some() || a.letter == self.codes.feed_word)
+                {
+                    return Err(NcError::line(
+                        n,
+                        format!(
+                            "{}: exponent notation is not G-code (it reads as {}{} and a word {}); write the number out",
+                            &text[a.span.start..b.span.end],
+                            a.letter,
+                            a.text,
+                            &text[b.span.clone()]
+                        ),
+                    ));
+                }
+            }
+        }
         let mut out = Applied { marker: self.marker(&lexed.comments), ..Applied::default() };
 
         let c = &self.codes;

@@ -25,7 +25,7 @@ mod rewrite;
 mod sequencer;
 mod verify;
 
-pub use dialect::{Code, Dialect, EventTiming};
+pub use dialect::{Clearance, Code, Dialect, EventTiming, FeedUnit};
 pub use error::NcError;
 pub use footprint::{footprints, Footprint, Footprints, Frame, Quad, Width, OVERLAP_TOLERANCE};
 pub use interp::{Event, Interp, Marker, Modal};

@@ -44,7 +44,22 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
     for (i, line) in lines.iter().enumerate() {
         let before_contact = it.m.contact;
         let before_mask = it.m.mask;
-        let a = it.apply(i, line)?;
+        let a = it.apply(i, line).map_err(|e| match (e, open) {
+            // Say which course: a line towpath cannot read inside one is often a course that
+            // was never closed running into the footer.
+            (NcError::Line { line, message }, Some(o)) if message.ends_with(" inside a course") => {
+                let end = if has_contact { dialect.contact_off.as_str() } else { "last tow cut" };
+                NcError::Line {
+                    line,
+                    message: format!(
+                        "{} inside the course opened at line {} (if that course should have ended before, its {end} is missing)",
+                        message.trim_end_matches(" inside a course"),
+                        o + 1
+                    ),
+                }
+            }
+            (e, _) => e,
+        })?;
         let in_course = |contact: bool, mask: u64| if has_contact { contact } else { mask != 0 };
         let was = in_course(before_contact, before_mask);
         let now = in_course(it.m.contact, it.m.mask);

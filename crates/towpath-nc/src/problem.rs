@@ -4,9 +4,9 @@
 //! transit into it ended and leaves at the end of its retract block; its reverse mode (when
 //! bidirectional layup is allowed and the course can be reversed) enters at the end of the
 //! retract block turned round and leaves at the start of the approach turned round. A mode's
-//! own cost is its approach and retract motion, so the route cost is the off-part motion of
-//! the courses. The route starts at the end of the header and ends free, or at the footer's end
-//! state when the footer writes every axis.
+//! own cost is its approach and retract motion (at their programmed feeds under the time cost),
+//! so the route cost is the off-part motion of the courses. The route starts at the end of the
+//! header and ends free, or at the footer's end state when the footer writes every axis.
 
 use towpath_machine::{CostKind, Machine, MachineCost, StateTable};
 use towpath_seq::{End, Mode, Problem, Step, TaskId};
@@ -172,26 +172,20 @@ pub fn build_problem(
         modes.push(m);
     }
     let end_state = footer_end(program, machine, dialect)?.map(|s| states.push(&s)).transpose()?;
-    let cost = MachineCost::new(machine.clone(), opts.cost, states)?;
+    let mut cost = MachineCost::new(machine.clone(), opts.cost, states)?;
+    if let Some((axis, value)) = dialect.clearance_axis(machine)? {
+        // The rewriter writes every transit by way of the clearance; the solver prices them so.
+        cost = cost.with_clearance(axis, value)?;
+    }
 
-    // Each mode's own cost: its approach and retract moves.
-    let own: Vec<f64> = (0..k)
-        .map(|c| {
-            program.segments[program.courses[c].segments.clone()]
-                .iter()
-                .filter(|s| !s.on_part)
-                .map(|s| {
-                    let (a, b) = (program.point(s.from), program.point(s.to));
-                    let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| y - x).collect();
-                    cost.segment(a, b, &d)
-                })
-                .sum()
-        })
-        .collect();
-
-    let mut b = Problem::builder(cost);
+    let mut b = Problem::builder(cost.clone());
     for (c, ms) in modes.iter().enumerate() {
-        b.task(ms.iter().map(|&(e, x)| Mode { entry: e, exit: x, cost: own[c] }).collect());
+        b.task(
+            ms.iter()
+                .enumerate()
+                .map(|(i, &(e, x))| Mode { entry: e, exit: x, cost: own_cost(program, c, &cost, dialect, i == 1) })
+                .collect(),
+        );
     }
     let mut edges = 0;
     match opts.precedence {
@@ -241,6 +235,33 @@ pub fn build_problem(
     let problem = b.build()?;
     let original = (0..k).map(|c| Step { task: TaskId(c as u32), mode: 0 }).collect();
     Ok(AfpProblem { problem, sets, set_plies, original, reversed, not_reversible, footprints: fps, edges })
+}
+
+/// A mode's own cost: course `c`'s approach and retract moves (its off-part moves), priced at
+/// their programmed feeds. Reversed, the original retract runs backwards as the approach with
+/// the motion code and feed of the original approach's last move, and the original approach
+/// as the retract with those of the original retract's first move (as `reverse.rs` writes
+/// them), so under the time cost the two modes may differ.
+fn own_cost(program: &Program, c: usize, cost: &MachineCost, dialect: &Dialect, reversed: bool) -> f64 {
+    let course = &program.courses[c];
+    let segs = &program.segments[course.segments.clone()];
+    let (start, end) = (course.on_part.start as u32, course.on_part.end as u32);
+    let how = |s: &crate::program::Segment| (s.rapid, s.feed);
+    let last_approach = segs.iter().rev().find(|s| s.line < start).map(how);
+    let first_retract = segs.iter().find(|s| s.line >= end).map(how);
+    segs.iter()
+        .filter(|s| !s.on_part)
+        .map(|s| {
+            let (rapid, feed) = match (reversed, s.line < start, s.line >= end) {
+                (true, true, _) => first_retract.unwrap_or(how(s)),
+                (true, _, true) => last_approach.unwrap_or(how(s)),
+                _ => how(s),
+            };
+            let (a, b) = (program.point(s.from), program.point(s.to));
+            let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| y - x).collect();
+            cost.segment_at(a, b, &d, (!rapid).then(|| dialect.feed_per_second(feed)))
+        })
+        .sum()
 }
 
 /// The machine state at the end of the footer, if the footer's moves write every axis in

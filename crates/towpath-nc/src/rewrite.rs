@@ -2,7 +2,8 @@
 //!
 //! Header, footer, every course span (approach, on-part and retract blocks) and every other line
 //! are copied byte for byte; a reversed course's span is the one [`crate::reverse_course`] builds.
-//! Between two spans the rewriter writes one rapid move that takes the machine from the end of
+//! Between two spans the rewriter writes one rapid move (or, with a clearance in the dialect,
+//! three: to the clearance, across, and down) that takes the machine from the end of
 //! the first to exactly the state (programmed values, set-position offsets, distance mode,
 //! motion mode, feed) in which the original program entered the second, so the second runs
 //! exactly as it did. Continuous and mandrel axes move the short way round; when that leaves a
@@ -77,6 +78,7 @@ pub fn rewrite(
         dialect,
         machine,
         crlf,
+        clearance: dialect.clearance_axis(machine)?,
     };
     for j in 0..program.header_end {
         e.original(program, j)?;
@@ -176,6 +178,8 @@ struct Emitter<'a> {
     dialect: &'a Dialect,
     machine: &'a Machine,
     crlf: bool,
+    /// Transits go by way of this value of this axis.
+    clearance: Option<(usize, f64)>,
 }
 
 impl Emitter<'_> {
@@ -214,8 +218,39 @@ impl Emitter<'_> {
         Ok(())
     }
 
-    /// One rapid move (and set-position and mode lines if needed) to reach `target`.
+    /// The transit to `target`: one rapid move, or with a clearance in the dialect, when an
+    /// axis other than the clearance axis moves, three (to the clearance, across, and to the
+    /// target's value); then set-position and mode lines if needed.
     fn transit(&mut self, target: &Modal) -> Result<(), NcError> {
+        if let Some((z, h)) = self.clearance {
+            let cur = self.it.m.clone();
+            let m = self.machine;
+            let others_move = (0..m.dim()).any(|i| {
+                let d = target.phys[i] - cur.phys[i];
+                i != z && (if m.axes[i].kind.wraps() { wrap(d) } else { d }).abs() > 1e-9
+            });
+            if others_move {
+                if (cur.phys[z] - h).abs() > 1e-9 {
+                    let mut up = cur.clone();
+                    up.prog[z] = cur.prog[z] + (h - cur.phys[z]);
+                    up.phys[z] = h;
+                    up.text[z] = None;
+                    self.move_to(&up)?;
+                }
+                let now = self.it.m.clone();
+                let mut across = target.clone();
+                across.prog[z] = now.prog[z];
+                across.phys[z] = now.phys[z];
+                across.text[z] = now.text[z];
+                self.move_to(&across)?;
+            }
+        }
+        self.move_to(target)?;
+        self.restore_modes(target)
+    }
+
+    /// One rapid move (and set-position lines if needed) to the axis values of `target`.
+    fn move_to(&mut self, target: &Modal) -> Result<(), NcError> {
         let d = self.dialect;
         let m = self.machine;
         let cur = self.it.m.clone();
@@ -279,6 +314,13 @@ impl Emitter<'_> {
             words.extend(reset);
             self.generated(words.join(" "))?;
         }
+        Ok(())
+    }
+
+    /// A line restoring the distance mode, motion mode, arc plane and feed of `target`, if
+    /// they differ.
+    fn restore_modes(&mut self, target: &Modal) -> Result<(), NcError> {
+        let d = self.dialect;
         let now = self.it.m.clone();
         let mut modal = Vec::new();
         if now.incremental != target.incremental {

@@ -2,12 +2,14 @@
 //! optimizer (it shares only the parser and the footprint geometry).
 //!
 //! It checks that the optimized program lays the same multiset of courses, each either with
-//! the same motion (points, tows on, feeds; its span byte-identical, or, if written anew,
-//! keeping its comments and unknown lines), or as a legal reversal (the same points in reverse order, the heading axis turned by 180°, the same tows
-//! on along every move, the same feeds on-part); that every line the original keeps (header,
-//! footer, comments and unknown lines) is still there; and that no course is laid before a
-//! course of an earlier ply it overlaps. It measures the off-part and on-part motion of both
-//! programs under every cost model the machine supports.
+//! the same motion (points, tows on, motion codes and feeds, approach and retract included; its
+//! span byte-identical, or, if written anew, keeping its comments and unknown lines), or as a
+//! legal reversal (the same points in reverse order, the heading axis turned by 180°, the same
+//! tows on along every move, the same feeds on-part, the reversed approach at the original
+//! approach's motion code and feed and the reversed retract at the original retract's); that
+//! every line the original keeps (header, footer, comments and unknown lines) is still there;
+//! and that no course is laid before a course of an earlier ply it overlaps. It measures the
+//! off-part and on-part motion of both programs under every cost model the machine supports.
 
 use std::collections::HashMap;
 
@@ -230,10 +232,10 @@ pub fn verify_parsed(
         inverse[i] = p.course;
     }
     let identity: Vec<usize> = (0..k).collect();
-    let before = measure(orig, machine, &identity, orig.header_end, orig.footer_start);
+    let before = measure(orig, machine, dialect, &identity, orig.header_end, orig.footer_start);
     // The optimized program starts with the original's header and ends with its footer.
     let footer_len = orig.lines.len() - orig.footer_start;
-    let after = measure(opt, machine, &inverse, orig.header_end, opt.lines.len() - footer_len);
+    let after = measure(opt, machine, dialect, &inverse, orig.header_end, opt.lines.len() - footer_len);
     Ok(Verification {
         courses: k,
         reversed: order.iter().filter(|p| p.reversed).count(),
@@ -350,8 +352,42 @@ fn is_forward(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Mac
         if ma.0 != mb.0 || ma.1 != mb.1 || (ma.0 && !same_feed(ma.2, mb.2)) {
             return Err(format!("move {i}: contact, tows or feed differ"));
         }
+        // Approach and retract moves keep their motion code and feed too: a roller brought
+        // down at a rapid is not the qualified program.
+        if !ma.0 && !same_feed(ma.2, mb.2) {
+            return Err(format!("move {i} (off-part): {} instead of {}", feed_name(mb.2), feed_name(ma.2)));
+        }
     }
     Ok(())
+}
+
+fn feed_name(f: f64) -> String {
+    if f.is_nan() {
+        "a rapid".into()
+    } else {
+        format!("feed {f}")
+    }
+}
+
+/// The motion code and feed (NaN: rapid) each move of original course `c`'s span must have
+/// when the course is laid reversed: the original retract, run backwards as the approach,
+/// takes those of the original approach's last move, and the original approach, run
+/// backwards as the retract, those of the original retract's first move; moves of the on-part
+/// block keep their own.
+fn reversed_feeds(p: &Program, c: usize) -> Vec<f64> {
+    let course = &p.courses[c];
+    let (start, end) = (course.on_part.start as u32, course.on_part.end as u32);
+    let segs = &p.segments[course.segments.clone()];
+    let feed = |s: &crate::program::Segment| if s.rapid { f64::NAN } else { s.feed };
+    let last_approach = segs.iter().rev().find(|s| s.line < start).map(feed);
+    let first_retract = segs.iter().find(|s| s.line >= end).map(feed);
+    segs.iter()
+        .map(|s| match (s.line < start, s.line >= end) {
+            (true, _) => first_retract.unwrap_or(feed(s)),
+            (_, true) => last_approach.unwrap_or(feed(s)),
+            _ => feed(s),
+        })
+        .collect()
 }
 
 /// Checks that optimized course `kc` is original course `oc` legally reversed.
@@ -365,6 +401,7 @@ fn is_reversal(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Ma
     if n != b.moves.len() {
         return Err(format!("{} moves instead of {}", b.moves.len(), n));
     }
+    let expected = reversed_feeds(orig, oc);
     let heading = machine.heading_axis();
     for i in 0..=n {
         let (pa, pb) = (&a.points[n - i], &b.points[i]);
@@ -397,6 +434,13 @@ fn is_reversal(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Ma
         }
         if ma.0 && !same_feed(ma.2, mb.2) {
             return Err(format!("reversed move {i}: feed {} instead of {}", mb.2, ma.2));
+        }
+        if !ma.0 && !same_feed(expected[n - 1 - i], mb.2) {
+            return Err(format!(
+                "reversed move {i} (off-part): {} instead of {}",
+                feed_name(mb.2),
+                feed_name(expected[n - 1 - i])
+            ));
         }
     }
     Ok(())
@@ -532,12 +576,19 @@ fn match_courses(
         }
         let start = laying_point(opt, kc, false);
         for oc in near(&by_start, start) {
-            if take(oc) && !out.iter().any(|x| x.0.course == oc) && is_forward(orig, oc, opt, kc, machine, tol).is_ok()
-            {
-                out.push((Placement { course: oc, reversed: false }, false));
-                if done(&out) {
-                    return (out, detail);
+            if !take(oc) || out.iter().any(|x| x.0.course == oc) {
+                continue;
+            }
+            match is_forward(orig, oc, opt, kc, machine, tol) {
+                Ok(()) => {
+                    out.push((Placement { course: oc, reversed: false }, false));
+                    if done(&out) {
+                        return (out, detail);
+                    }
                 }
+                // The first reason kept: the closest candidate, laid forward.
+                Err(e) if detail.is_empty() => detail = format!(": not {} laid forward: {e}", orig.course_name(oc)),
+                Err(_) => {}
             }
         }
         let cands = near(&by_end, start);
@@ -866,10 +917,13 @@ fn check_sets(orig: &Program, fps: &Footprints, order: &[Placement]) -> Result<(
 
 /// Motion of a program under every cost model the machine supports; `course_of[c]` maps the
 /// program's course c to the index it is reported under. Lines before `header_end` and from
-/// `footer_start` count as header and footer.
+/// `footer_start` count as header and footer. Under the time cost a rapid move takes the axes'
+/// limits and a feed move its programmed feed (in the dialect's `feed_unit`, capped by the
+/// limits; see [`Machine::feed_move_time`]).
 pub fn measure(
     p: &Program,
     machine: &Machine,
+    dialect: &Dialect,
     course_of: &[usize],
     header_end: usize,
     footer_start: usize,
@@ -894,7 +948,8 @@ pub fn measure(
             for i in 0..d.len() {
                 d[i] = b[i] - a[i];
             }
-            let c = cost.segment(a, b, &d);
+            let feed = (!s.rapid).then(|| dialect.feed_per_second(s.feed));
+            let c = cost.segment_at(a, b, &d, feed);
             if s.on_part {
                 m.on_part += c;
                 continue;

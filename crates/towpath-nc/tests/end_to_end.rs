@@ -112,3 +112,31 @@ fn doherty_refuses_to_keep_the_ply_order() {
         other => panic!("expected a solver error, got {:?}", other.map(|o| o.solver)),
     }
 }
+
+/// The target "off-part saving at least seed 000's on every analogous part": on each
+/// demo part with a published seed-000 figure, the off-part saving in seed 000's weighted axis
+/// distance, measured by the verifier on the written program (moves between precedence sets
+/// counted, which seed 000 leaves out), is at least the paper's. A work budget, not a time
+/// limit, so the outcome does not depend on the machine's load.
+#[test]
+fn demo_parts_save_at_least_seed_000_s_published_off_part_share() {
+    let d = Dialect::default();
+    let mut compared = 0;
+    for part in demo_parts() {
+        let Some((figure, seed_off, _)) = part.seed.filter(|s| s.1.is_finite()) else { continue };
+        let opts = OptimizeOptions {
+            afp: AfpOptions { bidirectional: true, width: Some(Width::Tow(TOW_WIDTH)), ..AfpOptions::default() },
+            time_limit: None,
+            iterations: Some(300),
+            threads: 1,
+            ..OptimizeOptions::default()
+        };
+        let o = optimize(&part.program, &part.machine, &d, &opts).unwrap();
+        let (b, a) = o.verification.motion(CostKind::Axis).unwrap();
+        let saved = 100.0 * (1.0 - a.off_part() / b.off_part());
+        eprintln!("{} ({figure}): towpath saves {saved:.1} %, seed 000 {seed_off:.1} %", part.name);
+        assert!(saved >= seed_off, "{} ({figure}): towpath saves {saved:.1} %, seed 000 {seed_off:.1} %", part.name);
+        compared += 1;
+    }
+    assert!(compared >= 6, "{compared} parts with a seed-000 figure");
+}

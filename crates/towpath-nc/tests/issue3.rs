@@ -774,3 +774,98 @@ fn contact_codes_outside_the_on_part_block_keep_a_course_forward() {
     assert!(o.order.iter().any(|pl| pl.course == 0 && !pl.reversed));
     verify(&text, &o.text, &m, &d, &vopts()).unwrap();
 }
+
+/// Motion time respects programmed feeds: rapids run at the axes' limits, feed moves at their
+/// F (mm/min, or deg/min for rotary axes alone), each axis ramping at its acceleration. Every
+/// figure below is worked out by hand for the demo gantry (X, Y: 1000 mm/s, 2000 mm/s²; Z: 500
+/// mm/s, 1000 mm/s²; C: 180°/s, 720°/s²).
+#[test]
+fn motion_time_respects_programmed_feeds() {
+    let m = towpath_nc::demo::gantry();
+    let text =
+        "%\nG21 G90\n(PLY 1)\n(COURSE 1)\nG0 X100 Y0 Z25 C0\nG1 Z0 F3000\nM20\nM60 P1\nG1 X400 F6000\nM61 P1\nM21\n\
+                G1 Z25 F3000\nG1 C90 F1800\nG1 X500 C180 F6000\nM30\n";
+    // Transit, a rapid from home: X 100 mm never reaches full speed, 2·√(100/2000) s; Z 25 mm
+    // is quicker.
+    let transit = 2.0 * (100.0f64 / 2000.0).sqrt();
+    // Approach and retract: 25 mm at 50 mm/s, plus 50/1000 s of ramps.
+    let z_move = 25.0 / 50.0 + 50.0 / 1000.0;
+    // On-part: 300 mm at 100 mm/s plus 100/2000 s.
+    let laid = 3.0 + 100.0 / 2000.0;
+    // Footer: C alone, 90° at 30°/s plus 30/720 s; then X 100 mm at 100 mm/s with C 90° in step
+    // (C cruises at 90°/s: 1 + 90/720 s, slower than X's 1 + 100/2000 s).
+    let footer = (3.0 + 30.0 / 720.0) + (1.0 + 90.0 / 720.0);
+    for (dialect, text) in [
+        (Dialect::default(), text.to_string()),
+        (
+            Dialect { feed_unit: towpath_nc::FeedUnit::PerSecond, ..Dialect::default() },
+            text.replace("F3000", "F50").replace("F6000", "F100").replace("F1800", "F30"),
+        ),
+    ] {
+        let v = verify(&text, &text, &m, &dialect, &VerifyOptions::default()).unwrap();
+        let (before, after) = v.motion(CostKind::Time).unwrap();
+        assert_eq!(before, after);
+        assert!((before.off_course[0] - (transit + 2.0 * z_move)).abs() < 1e-9, "{:?}", before);
+        assert!((before.on_part - laid).abs() < 1e-9, "{:?}", before);
+        assert!((before.off_other - footer).abs() < 1e-9, "{:?}", before);
+        // The distance costs do not depend on feeds: seed 000's axis cost is Σ C(a)·|Δa|.
+        let (axis, _) = v.motion(CostKind::Axis).unwrap();
+        assert!((axis.on_part - 300.0).abs() < 1e-9 && (axis.off_course[0] - 175.0).abs() < 1e-9, "{axis:?}");
+    }
+}
+
+/// `clearance = { axis = "Z", value = 50 }`: every transit towpath writes goes up to Z50, moves
+/// the other axes there, and comes down to where the next course's approach starts; X, Y and C
+/// never move below the clearance between courses. The optimized program verifies, and its
+/// measured off-part motion is what the solver priced.
+#[test]
+fn transits_go_by_way_of_the_clearance() {
+    let text = program();
+    let d = Dialect { clearance: Some(towpath_nc::Clearance { axis: "z".into(), value: 50.0 }), ..Dialect::default() };
+    let o = optimize(&text, &gantry(), &d, &opts(true)).unwrap();
+    assert!(!o.fell_back && o.order.iter().enumerate().any(|(i, p)| p.course != i || p.reversed));
+    let out = parse(&o.text, &gantry(), &d).unwrap();
+    let regions = out.regions();
+    let mut transit_moves = vec![0; out.courses.len()];
+    for s in &out.segments {
+        let towpath_nc::Region::Middle(k) = regions[s.line as usize] else { continue };
+        transit_moves[k] += 1;
+        let (a, b) = (out.point(s.from), out.point(s.to));
+        let sideways = (0..4).any(|i| i != 2 && (a[i] - b[i]).abs() > 1e-9);
+        if sideways {
+            assert!(a[2] == 50.0 && b[2] == 50.0, "line {}: {:?} -> {:?}", s.line + 1, a, b);
+        }
+        assert!(s.rapid, "line {}", s.line + 1);
+    }
+    // Up, across, down: three moves (one, straight down, where only Z changes).
+    assert!(transit_moves.iter().all(|&n| n == 1 || n == 3), "{transit_moves:?}\n{}", o.text);
+    assert!(transit_moves.iter().filter(|&&n| n == 3).count() >= 4, "{transit_moves:?}\n{}", o.text);
+    let (before, after) = o.verification.motion(CostKind::Axis).unwrap();
+    assert!(after.off_part() <= before.off_part());
+    let measured: f64 = after.off_course.iter().sum();
+    let route = towpath_seq::check(
+        &o.afp.problem,
+        &o.order
+            .iter()
+            .map(|p| towpath_seq::Step { task: towpath_seq::TaskId(p.course as u32), mode: p.reversed as u32 })
+            .collect::<Vec<_>>(),
+    )
+    .unwrap();
+    assert!((measured - route).abs() < 1e-6, "measured {measured}, solver {route}");
+    verify(&text, &o.text, &gantry(), &d, &vopts()).unwrap();
+    // The clearance axis must be a linear axis of the machine.
+    for (axis, says) in
+        [("Q", "clearance.axis: the machine has no axis \"Q\""), ("C", "clearance.axis: C is not a linear axis")]
+    {
+        let d =
+            Dialect { clearance: Some(towpath_nc::Clearance { axis: axis.into(), value: 50.0 }), ..Dialect::default() };
+        let e = parse(&text, &gantry(), &d).unwrap_err().to_string();
+        assert!(e.contains(says), "{e}");
+    }
+    let e = Dialect::from_toml_str("clearance = { axis = \"Z\", value = nan }").unwrap_err().to_string();
+    assert!(e.contains("clearance.value"), "{e}");
+    let e = Dialect::from_toml_str("clearance = { axis = \"Z\", height = 50.0 }").unwrap_err().to_string();
+    assert!(e.contains("unknown field `height`"), "{e}");
+    let d = Dialect::from_toml_str("clearance = { axis = \"Z\", value = 50.0 }").unwrap();
+    assert_eq!(Dialect::from_toml_str(&d.to_toml_string()).unwrap(), d);
+}

@@ -200,6 +200,36 @@ fn verifier_catches_illegal_reversals() {
     assert!(e.to_string().contains("axis C"), "{e}");
 }
 
+/// Approach and retract moves keep their motion code and feed, forward and reversed (the
+/// reversed approach takes the original approach's): a roller brought down at a rapid, or at
+/// another feed, is refused even though the laid motion is the same.
+#[test]
+fn verifier_catches_an_approach_at_a_rapid_or_another_feed() {
+    let d = Dialect::default();
+    let (orig, out) = optimized(false);
+    verify(&orig, &out, &gantry(), &d, &vopts()).unwrap();
+    for broken in [
+        out.replacen("G1 Z0 F1000\nM20\n", "G0 Z0\nG1 F1000\nM20\n", 1),
+        out.replacen("G1 Z0 F1000\nM20\n", "G1 Z0 F9000\nM20\n", 1),
+    ] {
+        assert_ne!(broken, out);
+        let e = verify(&orig, &broken, &gantry(), &d, &vopts()).unwrap_err();
+        assert!(matches!(e, VerifyError::Unmatched { .. }), "{e}");
+        assert!(e.to_string().contains("(off-part)"), "{e}");
+    }
+    // Course 1 first and reversed: its approach (the original retract run backwards) must take
+    // the original approach's G1 F1000.
+    let p = parse(&orig, &gantry(), &d).unwrap();
+    let rev: Vec<_> = (0..p.courses.len()).map(|c| reverse_course(&p, c, &gantry(), &d).ok()).collect();
+    let order: Vec<Placement> = (0..5).map(|c| Placement { course: c, reversed: c == 0 }).collect::<Vec<_>>();
+    let good = rewrite(&p, &order, &gantry(), &d, &rev).unwrap();
+    verify(&orig, &good, &gantry(), &d, &vopts()).unwrap();
+    let plunge = good.replacen("G1 Z0 F1000\nM20\nM60 P12\n", "G0 Z0\nG1\nM20\nM60 P12\n", 1);
+    assert_ne!(plunge, good);
+    let e = verify(&orig, &plunge, &gantry(), &d, &vopts()).unwrap_err();
+    assert!(e.to_string().contains("a rapid instead of feed 1000"), "{e}");
+}
+
 #[test]
 fn precedence_needs_a_width_and_says_so() {
     let d = Dialect::default();
@@ -258,11 +288,29 @@ fn bad_input_is_refused_with_the_line() {
     assert!(m.contains("never closed"), "{m}");
     // The M20 of the appended course: the line that opened it.
     assert_eq!(l, good.lines().count() + 2);
+    // A course whose lift is missing runs into a footer line towpath cannot read inside a
+    // course: the message names the course's opening line too.
+    let lifts: Vec<usize> = good.lines().enumerate().filter(|(_, l)| *l == "M21").map(|(i, _)| i).collect();
+    let last_lift = *lifts.last().unwrap();
+    let opened = good.lines().take(last_lift).enumerate().filter(|(_, l)| *l == "M20").map(|(i, _)| i).last().unwrap();
+    let cut: Vec<&str> = good.lines().enumerate().filter(|(i, _)| *i != last_lift).map(|(_, l)| l).collect();
+    let (l, m) = err_line(&(cut.join("\n") + "\n"));
+    assert_eq!(l, good.lines().count() - 1, "{m}");
+    assert!(
+        m.contains(&format!("inside the course opened at line {}", opened + 1)) && m.contains("M21 is missing"),
+        "{m}"
+    );
     let (l, m) = err_line(&with("G1 X200 F3000", "G1 Xnan F3000"));
     assert_eq!(l, 11);
     assert!(m.contains("no number"), "{m}");
     let (_, m) = err_line(&with("G1 X200 F3000", "G1 X200000000000 F3000"));
     assert!(m.contains("range"), "{m}");
+    // Exponent notation is not G-code: `X1e308` would read as X1 and a word E308.
+    let (l, m) = err_line(&with("G1 X200 F3000", "G1 X1e308 F3000"));
+    assert_eq!(l, 11);
+    assert!(m.contains("X1e308: exponent notation is not G-code (it reads as X1 and a word e308)"), "{m}");
+    let (_, m) = err_line(&with("G1 X200 F3000", "G1 X200 F3E3"));
+    assert!(m.contains("F3E3: exponent notation"), "{m}");
     let (_, m) = err_line(&with("M21\n", "M60 P1\nM21\n"));
     assert!(m.contains("tows still on"), "{m}");
     let (l, m) = err_line(&with("M60 P15\n", "M60 P15\nM60 P4\n"));

@@ -6,8 +6,8 @@
 use proptest::prelude::*;
 use towpath_machine::{Axis, AxisKind, CostKind, Machine};
 use towpath_nc::{
-    build_problem, optimize, parse, reverse_course, rewrite, verify, AfpOptions, Dialect, OptimizeOptions, Placement,
-    VerifyOptions, Width,
+    build_problem, optimize, parse, reverse_course, rewrite, verify, AfpOptions, Clearance, Dialect, OptimizeOptions,
+    Placement, VerifyOptions, Width,
 };
 use towpath_seq::{check, Step, TaskId};
 
@@ -145,7 +145,9 @@ fn program(spec: &PartSpec) -> String {
             }
             l.push(format!("M61 P{on}"));
             l.push("M21".into());
-            l.push("G1 Z20".into());
+            // Retracts of two heights, so that a reversed course's approach (the retract run
+            // backwards at the approach's feed) is not as long as its forward one.
+            l.push(if c.mask % 2 == 0 { "G1 Z20".into() } else { "G1 Z35".into() });
         }
     }
     l.push("G0 Z100".into());
@@ -225,6 +227,26 @@ proptest! {
         if !identity {
             let measured: f64 = a.off_course.iter().sum();
             prop_assert!((measured - route).abs() <= 1e-6 * (1.0 + route), "measured {} route {}", measured, route);
+            // Under the time cost too, where approach and retract moves run at their programmed
+            // feeds and a reversed course's approach takes the original approach's feed.
+            let timed = build_problem(&p, &m, &d, &AfpOptions { cost: CostKind::Time, ..opts.clone() }).unwrap();
+            let route = check(&timed.problem, &steps).unwrap();
+            let (_, a) = v.motion(CostKind::Time).unwrap();
+            let measured: f64 = a.off_course.iter().sum();
+            prop_assert!((measured - route).abs() <= 1e-6 * (1.0 + route), "time: measured {} route {}", measured, route);
+            // With a clearance, every transit goes up to it, across and down, as the solver
+            // prices it, under every cost model, and the program still verifies.
+            let dc = Dialect { clearance: Some(Clearance { axis: "Z".into(), value: 50.0 }), ..Dialect::default() };
+            let out = rewrite(&p, &order, &m, &dc, &afp.reversed).unwrap();
+            let v = verify(&text, &out, &m, &dc, &VerifyOptions { width: Some(Width::Tow(6.0)), ..VerifyOptions::default() }).unwrap();
+            prop_assert_eq!(&v.order, &order);
+            for cost in CostKind::ALL {
+                let priced = build_problem(&p, &m, &dc, &AfpOptions { cost, ..opts.clone() }).unwrap();
+                let route = check(&priced.problem, &steps).unwrap();
+                let (_, a) = v.motion(cost).unwrap();
+                let measured: f64 = a.off_course.iter().sum();
+                prop_assert!((measured - route).abs() <= 1e-6 * (1.0 + route), "{} with clearance: measured {} route {}", cost, measured, route);
+            }
         }
         // Every course reverses with the heading turned half a turn, but those holding an arc.
         for c in 0..p.courses.len() {

@@ -135,6 +135,39 @@ fn bad_input_names_file_and_line() {
         .arg(d.join("o.nc")));
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("m.toml") && err.contains("line 4"), "{err}");
+    // Text that is not UTF-8 (a Latin-1 degree sign in a comment): the line and byte.
+    let latin1 = d.join("latin1.nc");
+    let mut bytes = text.as_bytes().to_vec();
+    let at = text.find("(PLY 2").unwrap() + 4;
+    bytes.insert(at, 0xb0);
+    std::fs::write(&latin1, &bytes).unwrap();
+    let line = text[..at].matches('\n').count() + 1;
+    let (code, _, err) = run(towpath()
+        .arg("optimize")
+        .arg(&latin1)
+        .arg("--machine")
+        .arg(d.join("gantry-afp.toml"))
+        .arg("-o")
+        .arg(d.join("o.nc")));
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains(&format!("latin1.nc: line {line}: byte 5 (0xb0) is not UTF-8")), "{err}");
+    // A dialect that does not fit the machine names both files, not the program's first line.
+    let dialect = d.join("clash.toml");
+    std::fs::write(&dialect, "[clearance]\naxis = \"C\"\nvalue = 100.0\n").unwrap();
+    let (code, _, err) = run(towpath()
+        .arg("verify")
+        .arg(d.join("planar-0.nc"))
+        .arg(d.join("planar-0.nc"))
+        .arg("--machine")
+        .arg(d.join("gantry-afp.toml"))
+        .arg("--dialect")
+        .arg(&dialect));
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("gantry-afp.toml with")
+            && err.contains("clash.toml: dialect: clearance.axis: C is not a linear axis"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 
@@ -227,5 +260,76 @@ fn course_width_html_report_and_sets_precedence() {
     let (code, _, err) = run(&mut cmd);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("--tow-width") && err.contains("--course-width"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `-o` or `--report` naming an input (however spelt, or through a link) is refused before
+/// anything is written, so the input survives; so is a report over the output. A path that
+/// cannot be written is a bad argument (exit 2), and a time limit too large for a duration is
+/// refused, not a panic.
+#[test]
+fn outputs_never_overwrite_inputs() {
+    let d = temp_dir("overwrite");
+    demo(&d);
+    let program = d.join("planar-0.nc");
+    let original = std::fs::read(&program).unwrap();
+    let hard = d.join("hard.nc");
+    std::fs::hard_link(&program, &hard).unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(&program, d.join("link.nc")).unwrap();
+    let spelt_again = d.join(".").join("planar-0.nc");
+    let optimize = |extra: &[&std::ffi::OsStr]| {
+        run(towpath()
+            .arg("optimize")
+            .arg(&program)
+            .arg("--machine")
+            .arg(d.join("gantry-afp.toml"))
+            .arg("--dialect")
+            .arg(d.join("dialect.toml"))
+            .args(["--time-limit", "0.05", "--threads", "1"])
+            .args(extra))
+    };
+    let os = |p: &Path| p.as_os_str().to_owned();
+    let cases: Vec<(Vec<std::ffi::OsString>, &str)> = vec![
+        (vec!["-o".into(), os(&program)], "the output would overwrite the program"),
+        (vec!["-o".into(), os(&spelt_again)], "the output would overwrite the program"),
+        (vec!["-o".into(), os(&hard)], "the output would overwrite the program"),
+        #[cfg(unix)]
+        (vec!["-o".into(), os(&d.join("link.nc"))], "the output would overwrite the program"),
+        (vec!["-o".into(), os(&d.join("dialect.toml"))], "the output would overwrite the dialect file"),
+        (
+            vec!["-o".into(), os(&d.join("x.nc")), "--report".into(), os(&program)],
+            "the report would overwrite the program",
+        ),
+        (
+            vec!["-o".into(), os(&d.join("x.nc")), "--report".into(), os(&d.join(".").join("x.nc"))],
+            "the report and the output would be the same file",
+        ),
+    ];
+    for (extra, message) in cases {
+        let args: Vec<&std::ffi::OsStr> = extra.iter().map(|a| a.as_os_str()).collect();
+        let (code, _, err) = optimize(&args);
+        assert_eq!(code, 2, "{extra:?}: {err}");
+        assert!(err.contains(message), "{extra:?}: {err}");
+        assert_eq!(std::fs::read(&program).unwrap(), original, "{extra:?} changed the input");
+        assert!(!d.join("x.nc").exists(), "{extra:?} wrote an output before refusing");
+    }
+    // An output under a file (not a directory): refused as a bad argument, naming the path.
+    let under_a_file = program.join("out.nc");
+    let (code, _, err) = optimize(&["-o".as_ref(), under_a_file.as_os_str()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("cannot create the directory"), "{err}");
+    for cmd in [&["optimize"][..], &["demo"][..]] {
+        let mut c = towpath();
+        c.args(cmd);
+        if cmd[0] == "optimize" {
+            c.arg(&program).arg("--machine").arg(d.join("gantry-afp.toml")).arg("-o").arg(d.join("y.nc"));
+        } else {
+            c.arg("--dir").arg(d.join("demo2"));
+        }
+        let (code, _, err) = run(c.args(["--time-limit", "1e300"]));
+        assert_eq!(code, 2, "{cmd:?}: {err}");
+        assert!(err.contains("--time-limit 1e300: too large"), "{cmd:?}: {err}");
+    }
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -6,7 +6,6 @@
 //! verifies the output independently; and prints the savings beside seed 000's.
 
 use std::path::PathBuf;
-use std::time::Duration;
 
 use towpath_machine::CostKind;
 use towpath_nc::demo::{demo_parts, gantry, mandrel_machine, TOW_WIDTH};
@@ -41,9 +40,7 @@ pub struct Args {
 
 /// Runs the demo.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    if !(args.time_limit.is_finite() && args.time_limit >= 0.0) {
-        return Err(exit::bad_input(anyhow::anyhow!("--time-limit {}: give a number of seconds ≥ 0", args.time_limit)));
-    }
+    let time_limit = super::solver_args::time_limit(args.time_limit)?;
     let dir = &args.dir;
     let dialect = Dialect { tow_width: Some(TOW_WIDTH), ..Dialect::default() };
     write(&dir.join("gantry-afp.toml"), &gantry().to_toml_string())?;
@@ -52,7 +49,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let afp = AfpOptions { cost: args.cost, bidirectional: !args.unidirectional, ..AfpOptions::default() };
     let opts = OptimizeOptions {
         afp: afp.clone(),
-        time_limit: Some(Duration::from_secs_f64(args.time_limit)),
+        time_limit: Some(time_limit),
         solver: args.solver.solver,
         baselines: args.solver.params(),
         ..OptimizeOptions::default()

@@ -6,7 +6,7 @@ use std::time::Duration;
 use towpath_machine::CostKind;
 use towpath_nc::{optimize, AfpOptions, NcError, OptimizeOptions, PrecedenceRule, Report};
 
-use super::afp_common::{read, write, MachineArgs};
+use super::afp_common::{guard_outputs, read, write, MachineArgs};
 use super::solver_args::SolverArgs;
 use crate::exit;
 
@@ -66,11 +66,16 @@ pub fn classify(file: &std::path::Path, e: NcError) -> anyhow::Error {
 
 /// Runs `towpath optimize`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    if let Some(t) = args.time_limit {
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(exit::bad_input(anyhow::anyhow!("--time-limit {t}: give a number of seconds ≥ 0")));
-        }
+    let given_limit = args.time_limit.map(super::solver_args::time_limit).transpose()?;
+    let mut inputs = vec![("program", args.program.as_path()), ("machine file", args.machine.machine.as_path())];
+    if let Some(d) = &args.machine.dialect {
+        inputs.push(("dialect file", d.as_path()));
     }
+    let mut outputs = vec![("output", args.output.as_path())];
+    if let Some(r) = &args.report {
+        outputs.push(("report", r.as_path()));
+    }
+    guard_outputs(&inputs, &outputs)?;
     let (machine, dialect, width) = args.machine.load()?;
     let text = read(&args.program)?;
     let afp = AfpOptions {
@@ -81,8 +86,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         width,
     };
     // The course count decides the default time limit; count roller contacts cheaply.
-    let time_limit = match args.time_limit {
-        Some(t) => Duration::from_secs_f64(t),
+    let time_limit = match given_limit {
+        Some(t) => t,
         None => {
             let courses = text.lines().filter(|l| l.contains(dialect.contact_on.as_str())).count().max(1);
             towpath_nc::auto_time_limit(if dialect.contact_on.is_empty() { 1000 } else { courses })

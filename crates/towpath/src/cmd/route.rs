@@ -5,7 +5,6 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::Duration;
 
 use anyhow::Context;
 use towpath_baselines::{solve_with, SolverName};
@@ -68,7 +67,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let model = RppModel::new(instance).map_err(exit::bad_input)?;
     let mut opts = SolveOptions {
-        time_limit: Some(Duration::from_secs_f64(args.time_limit.max(0.0))),
+        time_limit: Some(super::solver_args::time_limit(args.time_limit)?),
         seed: args.seed,
         ..SolveOptions::default()
     };

@@ -55,12 +55,7 @@ const DEFAULT_TIME_LIMIT: f64 = 10.0;
 /// Runs `towpath solve`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let time_limit = match (args.time_limit, args.iterations) {
-        (Some(t), _) => {
-            if !(t.is_finite() && t >= 0.0) {
-                return Err(exit::bad_input(anyhow!("--time-limit must be a non-negative number of seconds, got {t}")));
-            }
-            Some(Duration::from_secs_f64(t))
-        }
+        (Some(t), _) => Some(super::solver_args::time_limit(t)?),
         (None, Some(_)) => None,
         (None, None) => Some(Duration::from_secs_f64(DEFAULT_TIME_LIMIT)),
     };

@@ -59,3 +59,13 @@ pub fn refusal(name: SolverName, e: &BaselineError) -> String {
 pub fn refused(name: SolverName, e: BaselineError) -> anyhow::Error {
     exit::bad_input(anyhow::anyhow!("{}", refusal(name, &e)))
 }
+
+/// A `--time-limit` in seconds as a duration: refused (exit code 2) unless it is a number ≥ 0
+/// small enough to be a duration (about 584 billion years).
+pub fn time_limit(seconds: f64) -> anyhow::Result<std::time::Duration> {
+    if !(seconds.is_finite() && seconds >= 0.0) {
+        return Err(exit::bad_input(anyhow::anyhow!("--time-limit {seconds:?}: give a number of seconds ≥ 0")));
+    }
+    std::time::Duration::try_from_secs_f64(seconds)
+        .map_err(|_| exit::bad_input(anyhow::anyhow!("--time-limit {seconds:?}: too large a number of seconds")))
+}
