@@ -69,6 +69,9 @@ pub(crate) struct Net<'p, C> {
     dense: Vec<Cost>,
     /// Width of `dense` (0 when there is no table).
     dense_w: usize,
+    /// One mode per task, entering and leaving at the state with the task's own number, and no
+    /// depot: an arc is the cost model's cost between the two node numbers.
+    identity: bool,
 }
 
 /// Largest number of (node, mode) pairs for which the arcs are tabulated (a table of at most
@@ -176,11 +179,18 @@ impl<'p, C: CostModel> Net<'p, C> {
             typical_arc: 1.0,
             dense: Vec::new(),
             dense_w: 0,
+            identity: false,
         };
         let (mean, max) = net.sample_arcs();
         net.typical_arc = mean;
         net.forbidden = (max * 1e6).max(MIN_FORBIDDEN);
         net.wrap_ok = net.reversal_symmetric && depot_symmetric && !net.has_prec && !net.has_groups;
+        net.identity = depot == u32::MAX
+            && (0..n_tasks).all(|t| {
+                net.mode_base[t + 1] - net.mode_base[t] == 1
+                    && net.entry[net.mode_base[t] as usize] == StateId(t as u32)
+                    && net.exit[net.mode_base[t] as usize] == StateId(t as u32)
+            });
         net.tabulate();
         net
     }
@@ -255,6 +265,9 @@ impl<'p, C: CostModel> Net<'p, C> {
     pub fn arc(&self, a: u32, ma: u32, b: u32, mb: u32) -> Cost {
         if self.dense_w != 0 {
             return self.dense[self.dense_index(a, ma) * self.dense_w + self.dense_index(b, mb)];
+        }
+        if self.identity {
+            return self.p.transition(StateId(a), StateId(b)).min(self.forbidden).max(-self.forbidden);
         }
         // `min` maps +inf and NaN to the forbidden price
         self.raw_arc(a, ma, b, mb).min(self.forbidden).max(-self.forbidden)
