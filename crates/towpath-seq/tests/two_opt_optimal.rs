@@ -59,3 +59,27 @@ fn strokes_answer_is_two_opt_local_optimal() {
         assert_eq!(moves, 0, "seed {seed}: {moves} improving 2-opt moves left");
     }
 }
+
+/// A tour of 2200 cities: large enough for the Lin–Kernighan move's backtracking first level
+/// (tried, undone and tried again; the test profile keeps the debug check that the tracked cost
+/// equals the cost recomputed after every improving move). The answer is feasible, priced as
+/// an independent sum says, and 2-opt-local-optimal.
+#[test]
+fn large_tour_with_backtracking_is_two_opt_local_optimal() {
+    let mut rng = Pcg64Mcg::seed_from_u64(7);
+    let pts: Vec<[f64; 3]> = (0..2200).map(|_| [rng.gen_range(0.0..1000.0), rng.gen_range(0.0..1000.0), 0.0]).collect();
+    let mut b = Problem::builder(PointCost::new(pts.clone(), Metric::Euclidean));
+    b.point_tasks(pts.len());
+    let p = b.build().unwrap();
+    let opts = SolveOptions { time_limit: None, iterations: Some(3000), threads: 1, seed: 3, ..Default::default() };
+    let r = solve(&p, &opts).unwrap();
+    let cost = check(&p, &r.solution.steps).unwrap();
+    let order: Vec<usize> = r.solution.steps.iter().map(|s| s.task.index()).collect();
+    let d = |a: usize, b: usize| ((pts[a][0] - pts[b][0]).powi(2) + (pts[a][1] - pts[b][1]).powi(2)).sqrt();
+    let n = order.len();
+    let sum: f64 = (0..n).map(|i| d(order[i], order[(i + 1) % n])).sum();
+    assert!((sum - cost).abs() <= 1e-6 * sum, "reported {cost}, recomputed {sum}");
+    assert!(cost < r.first_local_optimum, "the kicks improved nothing");
+    let moves = improving_two_opt_moves(&pts, &p, &r.solution.steps);
+    assert_eq!(moves, 0, "{moves} improving 2-opt moves left");
+}
