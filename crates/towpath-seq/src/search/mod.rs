@@ -304,16 +304,20 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
 /// Temperature of the kick acceptance at a fraction `frac` of the budget. Under precedence,
 /// where kicks are few and the search easily stays in one basin, a kick that makes the tour
 /// dearer by Δ is kept with probability exp(-Δ/T) (simulated-annealing acceptance); T starts at
-/// the mean arc of the best tour and falls as (1 - frac)². Measured on ten TSPLIB SOP and
+/// twice the mean arc of the best tour and falls as (1 - frac)². Measured on ten TSPLIB SOP and
 /// SOPLIB instances at equal work (10,000 kicks, one thread, 3 seeds): the mean gap to the best
-/// known fell from 6.9 % to 4.7 % (ft70.2 and kro124p.1 optimal in 2/3 and 2/3 runs, were 0/3);
-/// a start of half or twice the mean arc did worse. Other problems keep "not worse" acceptance.
+/// known fell from 6.9 % to 4.7 % with a start at the mean arc (ft70.2 and kro124p.1 optimal in
+/// 2/3 and 2/3 runs, were 0/3). With the faster local search (`prunes_by_gain`) a 10 s search
+/// does 4x more kicks, and there twice the mean arc did better (10 s, 2 cores, medians of 3
+/// seeds: prob.100 1233 -> 1193, kro124p.3 50168 -> 49499, R.300.100.15 3272 -> 3233,
+/// R.200.100.1 79 -> 80, R.200.100.15 and ft70.3 equal; half did worse, three times mixed).
+/// Other problems keep "not worse" acceptance.
 fn acceptance_temperature<C: CostModel>(net: &Net<C>, best: Cost, frac: f64) -> Cost {
     if !net.has_prec {
         return 0.0;
     }
     let mean_arc = if best.abs() < net.forbidden { best.abs() / net.n as f64 } else { net.typical_arc };
-    mean_arc * (1.0 - frac).powi(2)
+    2.0 * mean_arc * (1.0 - frac).powi(2)
 }
 
 /// Share of a time limit the construction and the first descents may take. On seed-004-like
