@@ -40,6 +40,10 @@ const LK_BREADTH_FROM: usize = 2000;
 /// 2-opt moves).
 const LK_BREADTH_UP_TO: usize = 20_000;
 
+/// Longest tentative reversal of a Lin–Kernighan step on tours above `LK_BREADTH_UP_TO` nodes,
+/// where an array reversal of half the tour costs more than the rest of the step.
+const LK_TENTATIVE_HUGE: usize = 1000;
+
 /// One step of a Lin–Kernighan chain: reverse positions `lo..=hi` (adding t2–t3, removing
 /// t3–t4), changing the cost by `step`; `g2` is the partial gain after it.
 #[derive(Clone, Copy)]
@@ -75,6 +79,9 @@ pub(crate) struct LocalSearch<'a, 'p, C> {
     cands: Vec<(usize, u32)>,
     /// Alternatives tried at the first level of a Lin–Kernighan move.
     lk_breadth: usize,
+    /// Longest stretch a Lin–Kernighan step reverses tentatively (closings are priced whatever
+    /// their length).
+    lk_max_tentative: usize,
 }
 
 /// Whether Or-opt and the segment exchange apply the positive-gain criterion: a move whose
@@ -117,6 +124,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             lk_touched: Vec::new(),
             cands: Vec::new(),
             lk_breadth: if (LK_BREADTH_FROM..=LK_BREADTH_UP_TO).contains(&net.n) { LK_BREADTH } else { 1 },
+            lk_max_tentative: if net.n > LK_BREADTH_UP_TO { LK_TENTATIVE_HUGE } else { usize::MAX },
         }
     }
 
@@ -885,7 +893,13 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 close_total = total;
                 close = Some(step);
             }
-            // keep the `cap` largest partial gains, best first
+            // keep the `cap` largest partial gains, best first (on huge tours only short
+            // stretches are reversed tentatively)
+            let len = hi - lo + 1;
+            let len = if net.wrap_ok { len.min(tour.len() - len) } else { len };
+            if len > self.lk_max_tentative {
+                continue;
+            }
             if deeper.len() < cap || deeper.last().is_some_and(|d| g2 > d.g2) {
                 let at = deeper.iter().position(|d| g2 > d.g2).unwrap_or(deeper.len());
                 deeper.insert(at, step);
