@@ -79,6 +79,10 @@ pub(crate) struct LocalSearch<'a, 'p, C> {
     cands: Vec<(usize, u32)>,
     /// Alternatives tried at the first level of a Lin–Kernighan move.
     lk_breadth: usize,
+    /// Scratch lists of Lin–Kernighan steps: the first level's alternatives and a deeper
+    /// level's best step.
+    lk_alts: Vec<LkStep>,
+    lk_one: Vec<LkStep>,
     /// Longest stretch a Lin–Kernighan step reverses tentatively (closings are priced whatever
     /// their length).
     lk_max_tentative: usize,
@@ -125,6 +129,8 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             cands: Vec::new(),
             lk_breadth: if (LK_BREADTH_FROM..=LK_BREADTH_UP_TO).contains(&net.n) { LK_BREADTH } else { 1 },
             lk_max_tentative: if net.n > LK_BREADTH_UP_TO { LK_TENTATIVE_HUGE } else { usize::MAX },
+            lk_alts: Vec::new(),
+            lk_one: Vec::new(),
         }
     }
 
@@ -701,9 +707,9 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             }
         };
         // A new arc at least as long as the removal gain is not tried (`prunes_by_gain`);
-        // neighbour lists are sorted, so stop. With several modes (when they are a task's orientations) the lists' lower bounds
-        // (cheapest over mode pairs) stand in for the arc, and a single task's cheapest mode cost
-        // joins it (its mode may change).
+        // neighbour lists are sorted, so stop. With several modes (when they are a task's
+        // orientations) the lists' lower bounds (cheapest over mode pairs) stand in for the arc,
+        // and a single task's cheapest mode cost joins it (its mode may change).
         let prune = prunes_by_gain(net);
         let slack = if net.multi_mode && i == j { net.min_mode_cost(s) } else { 0.0 };
         let too_long = |a: u32, b: u32, lb: Cost| {
@@ -767,7 +773,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             tour.begin();
         }
         let mut improved = false;
-        let mut alts: Vec<LkStep> = Vec::with_capacity(self.lk_breadth);
+        let mut alts = std::mem::take(&mut self.lk_alts);
         'dirs: for first_forward in [true, false] {
             let start = tour.mark();
             let t2 = if first_forward { tour.next(t1) } else { tour.prev(t1) };
@@ -798,6 +804,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             }
             tour.undo_to(start);
         }
+        self.lk_alts = alts;
         if improved {
             let touched = std::mem::take(&mut self.lk_touched);
             for &x in &touched {
@@ -816,23 +823,26 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
     /// closing improved the tour (left applied); false leaves the tentative steps for the
     /// caller to undo.
     fn lk_deeper(&mut self, tour: &mut Tour, t1: u32, mut t2: u32, mut g: Cost, mut so_far: Cost) -> bool {
-        let mut one: Vec<LkStep> = Vec::with_capacity(1);
+        let mut one = std::mem::take(&mut self.lk_one);
+        let mut improved = false;
         for depth in 2..=LK_DEPTH {
             one.clear();
             if let Some(c) = self.lk_level(tour, t1, t2, g, so_far, depth, 1, &mut one) {
                 self.lk_apply(tour, &c);
-                return true;
+                improved = true;
+                break;
             }
-            let Some(&step) = one.first() else { return false };
+            let Some(&step) = one.first() else { break };
             if depth == LK_DEPTH {
-                return false;
+                break;
             }
             self.lk_apply(tour, &step);
             so_far += step.step;
             t2 = step.t4;
             g = step.g2;
         }
-        false
+        self.lk_one = one;
+        improved
     }
 
     /// One level of a Lin–Kernighan chain: prices every candidate t3 of `t2`. Returns the best

@@ -240,12 +240,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         };
         let left = total_kicks - iterations;
         let kicks_each = per_epoch.min(left.div_ceil(threads as u64));
-        let frac = match (opts.time_limit, opts.iterations) {
-            (Some(tl), None) => t0.elapsed().as_secs_f64() / tl.as_secs_f64(),
-            (_, Some(it)) => iterations as f64 / it as f64,
-            _ => 1.0,
-        }
-        .min(1.0);
+        let frac = budget_used(opts, t0, iterations).unwrap_or(1.0);
         let temperature = acceptance_temperature(&net, best.cost, frac);
         let budget = Budget { kicks: kicks_each, deadline: epoch_deadline, hard: search_end, temperature };
         let cancel = opts.cancel.as_deref();
@@ -276,12 +271,8 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         }
         iterations += done;
         if let Some(cb) = &opts.progress {
-            let fraction = match (opts.time_limit, opts.iterations) {
-                (Some(tl), _) if opts.iterations.is_none() => t0.elapsed().as_secs_f64() / tl.as_secs_f64(),
-                (_, Some(it)) => iterations as f64 / it as f64,
-                _ => 0.0,
-            };
-            cb(&Progress { elapsed: t0.elapsed(), best_cost: best.cost, iterations, fraction: fraction.min(1.0) });
+            let fraction = budget_used(opts, t0, iterations).unwrap_or(0.0);
+            cb(&Progress { elapsed: t0.elapsed(), best_cost: best.cost, iterations, fraction });
         }
         if done == 0 {
             break;
@@ -300,6 +291,17 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         }
     }
     Ok(SolveReport { solution, initial_cost, first_local_optimum, iterations, elapsed: t0.elapsed(), exact: false })
+}
+
+/// Fraction of the budget used, in 0..=1: of the work budget when there is one, else of the
+/// time limit; `None` without either.
+fn budget_used(opts: &SolveOptions, t0: Instant, iterations: u64) -> Option<f64> {
+    let f = match (opts.time_limit, opts.iterations) {
+        (_, Some(it)) => iterations as f64 / it as f64,
+        (Some(tl), None) => t0.elapsed().as_secs_f64() / tl.as_secs_f64(),
+        (None, None) => return None,
+    };
+    Some(f.min(1.0))
 }
 
 /// Temperature of the kick acceptance at a fraction `frac` of the budget. Under precedence,

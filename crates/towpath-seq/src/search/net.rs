@@ -217,7 +217,7 @@ impl<'p, C: CostModel> Net<'p, C> {
         let mut dense = Vec::with_capacity(w * w);
         for &(a, ma) in &of {
             for &(b, mb) in &of {
-                dense.push(self.raw_arc(a, ma, b, mb).min(self.forbidden).max(-self.forbidden));
+                dense.push(self.priced(self.raw_arc(a, ma, b, mb)));
             }
         }
         self.dense = dense;
@@ -267,10 +267,15 @@ impl<'p, C: CostModel> Net<'p, C> {
             return self.dense[self.dense_index(a, ma) * self.dense_w + self.dense_index(b, mb)];
         }
         if self.identity {
-            return self.p.transition(StateId(a), StateId(b)).min(self.forbidden).max(-self.forbidden);
+            return self.priced(self.p.transition(StateId(a), StateId(b)));
         }
-        // `min` maps +inf and NaN to the forbidden price
-        self.raw_arc(a, ma, b, mb).min(self.forbidden).max(-self.forbidden)
+        self.priced(self.raw_arc(a, ma, b, mb))
+    }
+
+    /// A raw transition cost clamped to ±the forbidden price (`min` maps +inf and NaN to it).
+    #[inline]
+    fn priced(&self, raw: Cost) -> Cost {
+        raw.min(self.forbidden).max(-self.forbidden)
     }
 
     #[inline]
