@@ -1,6 +1,7 @@
 //! towpath's own solver: construction, local search with modes and precedence, and iterated
 //! local search on several threads within a time or work budget.
 
+mod alpha;
 mod construct;
 mod ils;
 mod local;
@@ -186,7 +187,15 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
     } else {
         10
     };
-    let nb = Neighbors::build(&net, k);
+    let mut nb = Neighbors::build(&net, k);
+    // On symmetric one-mode tours the lowest-α neighbours replace the nearest ones when they
+    // are affordable (see `alpha`).
+    if let Some(steps) = alpha::plan(net.n, threads, opts.time_limit.map(|d| d.as_secs_f64())) {
+        let ub = starts.iter().map(|t| t.cost).fold(Cost::INFINITY, Cost::min);
+        if let Some(lists) = alpha::candidates(&net, &nb, steps, ub, threads) {
+            nb = lists;
+        }
+    }
     let ils = Ils::new(&net, &nb, eps);
     // Descend from the best few constructed starts and from the initial route; keep the best
     // local optimum.

@@ -68,6 +68,24 @@ impl Neighbors {
         }
     }
 
+    /// Lists given per task (each sorted by cost, as the searches expect), on a symmetric cost
+    /// model.
+    pub fn from_lists<C: CostModel>(net: &Net<C>, lists: Vec<Vec<u32>>) -> Self {
+        let n = net.n_tasks;
+        debug_assert_eq!(lists.len(), n);
+        let k = lists.iter().map(Vec::len).max().unwrap_or(0).max(1);
+        let mut out = vec![u32::MAX; n * k];
+        let mut out_lb = vec![Cost::INFINITY; n * k];
+        for (v, list) in lists.iter().enumerate() {
+            for (i, &u) in list.iter().enumerate() {
+                out[v * k + i] = u;
+                out_lb[v * k + i] = min_arc(net, v as u32, u);
+            }
+        }
+        let out_len = lists.iter().map(|l| l.len() as u8).collect();
+        Neighbors { k, out, out_len, inn: Vec::new(), inn_len: Vec::new(), out_lb, inn_lb: Vec::new(), symmetric: true }
+    }
+
     pub fn build<C: CostModel>(net: &Net<C>, k: usize) -> Self {
         let n = net.n_tasks;
         let k = k.min(n.saturating_sub(1)).max(1);

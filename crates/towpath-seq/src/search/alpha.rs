@@ -1,0 +1,513 @@
+//! α-nearness candidate lists (Helsgaun, "An effective implementation of the Lin–Kernighan
+//! traveling salesman heuristic", EJOR 126, 2000, sections 4.1–4.2).
+//!
+//! A subgradient ascent (Held and Karp) looks for node penalties π that make the minimum
+//! 1-tree under the costs c(i,j) + π(i) + π(j) as close to a tour as it can (every degree 2).
+//! The α-value of an edge is then how much dearer the minimum 1-tree becomes when it is forced
+//! to contain that edge: the edge's penalised cost less the dearest edge on the tree path
+//! between its ends. Edges of optimal tours have small α far more reliably than they are short:
+//! the few lowest-α edges per node make better candidates than the nearest neighbours.
+//!
+//! Used for symmetric one-mode closed tours (TSP). The ascent works on a sparse graph (the
+//! nearest-neighbour lists, both ways, joined where they fall apart); the α-values are exact
+//! for that tree, over all node pairs (O(n²) arc evaluations per run).
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use super::neighbors::Neighbors;
+use super::net::Net;
+use crate::cost::{Cost, CostModel};
+
+/// The sparse graph in compressed rows, with each edge's plain cost.
+struct Graph {
+    off: Vec<u32>,
+    to: Vec<u32>,
+    cost: Vec<Cost>,
+}
+
+/// A minimum spanning tree: each node's parent (the root's is itself), the order in which Prim
+/// reached the nodes (parents before children) and the degrees.
+struct Tree {
+    parent: Vec<u32>,
+    order: Vec<u32>,
+    degree: Vec<u32>,
+    /// Penalised cost of the tree plus the 1-tree's extra edge.
+    cost: Cost,
+}
+
+#[derive(PartialEq)]
+struct Item(Cost, u32, u32);
+
+impl Eq for Item {}
+
+impl Ord for Item {
+    fn cmp(&self, other: &Self) -> Ordering {
+        // a min-heap on the key, then the node
+        other.0.total_cmp(&self.0).then(other.1.cmp(&self.1))
+    }
+}
+
+impl PartialOrd for Item {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+/// Lowest-α neighbours per node.
+const ALPHA_K: usize = 8;
+
+/// Nearest neighbours kept beside them. α alone (8 per node) did worse on instances with
+/// clusters of coincident points: on fl1577 at 5 s, 2 cores, 4.2-4.9 % above the optimum
+/// where the nearest 10 gave 0.46 %; with the nearest 5 added, 0.05-0.14 %. Over 19 TSPLIB
+/// instances of 200-2392 nodes (5 s, 2 cores, seeds 1 and 2) the gaps summed to 3.5 % and
+/// 3.3 %, against 6.2 % and 6.6 % with the nearest 10 and 10.3 % and 8.9 % with α alone.
+const NEAREST_KEPT: usize = 5;
+
+/// Largest ascent: Polyak steps usually stop improving the bound well before this.
+const MAX_ASCENT: usize = 300;
+
+/// Estimated time of one ascent step per node (a heap-based Prim over ~13 edges a node,
+/// measured 0.45-0.65 µs on pr1002-pcb3038) and of one α pair (a cost and a tree step).
+const STEP_SECONDS_PER_NODE: f64 = 7e-7;
+const PAIR_SECONDS: f64 = 1.5e-8;
+
+/// Share of a time limit the lists may take.
+const TIME_SHARE: f64 = 0.05;
+
+/// Largest instance without a time limit (the α pass is O(n²)).
+const MAX_NODES: usize = 8000;
+
+/// How many ascent steps to take on `n` nodes with `threads` threads within `seconds`, or
+/// `None` when the lists would cost too much of the limit (or of the work, without one).
+pub(crate) fn plan(n: usize, threads: usize, seconds: Option<f64>) -> Option<usize> {
+    let Some(s) = seconds else {
+        return (n <= MAX_NODES).then_some(MAX_ASCENT);
+    };
+    let budget = s * TIME_SHARE;
+    let pairs = (n as f64).powi(2) * PAIR_SECONDS / threads.max(1) as f64;
+    if pairs > budget {
+        return None;
+    }
+    Some(MAX_ASCENT.min(((budget - pairs) / (n as f64 * STEP_SECONDS_PER_NODE)) as usize))
+}
+
+/// Candidate lists of the [`ALPHA_K`] lowest-α neighbours of each node and its
+/// [`NEAREST_KEPT`] nearest in `nb`, sorted by cost as the local search expects; the ascent
+/// takes at most `steps` steps over the graph of `nb`, and `ub` is the cost of a tour (for the
+/// step length). `None` unless the instance is a closed tour with
+/// one mode per task and symmetric costs.
+pub(crate) fn candidates<C: CostModel>(
+    net: &Net<C>,
+    nb: &Neighbors,
+    steps: usize,
+    ub: Cost,
+    threads: usize,
+) -> Option<Neighbors> {
+    let n = net.n;
+    if !net.plain_symmetric || net.multi_mode || net.depot != u32::MAX || net.has_prec || net.has_groups {
+        return None;
+    }
+    if n <= ALPHA_K + 1 || !ub.is_finite() {
+        return None;
+    }
+    let arc = |a: u32, b: u32| net.arc(a, 0, b, 0);
+    let mut g = sparse_graph(n, nb, &arc);
+    let pi = ascent(&mut g, n, steps, ub, &arc);
+    let tree = prim(&mut g, &pi, &arc);
+    let mut lists = lowest_alpha(n, &tree, &pi, ALPHA_K, threads, &arc);
+    for (v, list) in lists.iter_mut().enumerate() {
+        let v = v as u32;
+        for &u in nb.out(v).iter().take(NEAREST_KEPT) {
+            if !list.contains(&u) {
+                list.push(u);
+            }
+        }
+        list.sort_by(|&x, &y| arc(v, x).total_cmp(&arc(v, y)).then(x.cmp(&y)));
+    }
+    Some(Neighbors::from_lists(net, lists))
+}
+
+/// The nearest-neighbour lists as an undirected graph.
+fn sparse_graph(n: usize, nb: &Neighbors, arc: &impl Fn(u32, u32) -> Cost) -> Graph {
+    let mut edges: Vec<(u32, u32)> = Vec::new();
+    for v in 0..n as u32 {
+        for &u in nb.out(v) {
+            edges.push((v, u));
+            edges.push((u, v));
+        }
+    }
+    edges.sort_unstable();
+    edges.dedup();
+    let mut off = vec![0u32; n + 1];
+    for &(a, _) in &edges {
+        off[a as usize + 1] += 1;
+    }
+    for i in 0..n {
+        off[i + 1] += off[i];
+    }
+    let to: Vec<u32> = edges.iter().map(|&(_, b)| b).collect();
+    let cost = edges.iter().map(|&(a, b)| arc(a, b)).collect();
+    Graph { off, to, cost }
+}
+
+/// Minimum spanning tree of the sparse graph under the penalised costs (Prim from node 0). If
+/// the graph falls apart, the cheapest edge from the tree to the rest is found by a full scan
+/// and added to the graph for good.
+fn prim(g: &mut Graph, pi: &[Cost], arc: &impl Fn(u32, u32) -> Cost) -> Tree {
+    let n = pi.len();
+    let mut parent = vec![u32::MAX; n];
+    let mut key = vec![Cost::INFINITY; n];
+    let mut done = vec![false; n];
+    let mut order = Vec::with_capacity(n);
+    let mut degree = vec![0u32; n];
+    let mut heap = BinaryHeap::new();
+    let mut cost = 0.0;
+    parent[0] = 0;
+    key[0] = 0.0;
+    heap.push(Item(0.0, 0, 0));
+    while order.len() < n {
+        let Some(Item(c, v, p)) = heap.pop() else {
+            // disconnected: join the cheapest outside node by a full scan
+            let (c, v, p) = cheapest_link(&done, pi, arc);
+            add_edge(g, p, v, arc(p, v));
+            heap.push(Item(c, v, p));
+            continue;
+        };
+        if done[v as usize] {
+            continue;
+        }
+        done[v as usize] = true;
+        order.push(v);
+        if v != p {
+            parent[v as usize] = p;
+            degree[v as usize] += 1;
+            degree[p as usize] += 1;
+            cost += c;
+        }
+        let (a, b) = (g.off[v as usize] as usize, g.off[v as usize + 1] as usize);
+        for e in a..b {
+            let u = g.to[e];
+            if done[u as usize] {
+                continue;
+            }
+            let cu = g.cost[e] + pi[v as usize] + pi[u as usize];
+            if cu < key[u as usize] {
+                key[u as usize] = cu;
+                heap.push(Item(cu, u, v));
+            }
+        }
+    }
+    // the 1-tree's extra edge: from the leaf whose cheapest non-tree edge is dearest
+    let mut extra: Option<(Cost, u32, u32)> = None;
+    for v in 0..n as u32 {
+        if degree[v as usize] != 1 {
+            continue;
+        }
+        let (a, b) = (g.off[v as usize] as usize, g.off[v as usize + 1] as usize);
+        let mut second: Option<(Cost, u32)> = None;
+        for e in a..b {
+            let u = g.to[e];
+            if parent[v as usize] == u || parent[u as usize] == v {
+                continue;
+            }
+            let cu = g.cost[e] + pi[v as usize] + pi[u as usize];
+            if second.is_none_or(|s| cu < s.0) {
+                second = Some((cu, u));
+            }
+        }
+        if let Some((c, u)) = second {
+            if extra.is_none_or(|x| c > x.0) {
+                extra = Some((c, v, u));
+            }
+        }
+    }
+    if let Some((c, v, u)) = extra {
+        degree[v as usize] += 1;
+        degree[u as usize] += 1;
+        cost += c;
+    }
+    Tree { parent, order, degree, cost }
+}
+
+/// The cheapest edge from a reached node to an unreached one, as (penalised cost, outside
+/// node, tree node).
+fn cheapest_link(done: &[bool], pi: &[Cost], arc: &impl Fn(u32, u32) -> Cost) -> (Cost, u32, u32) {
+    let mut best = (Cost::INFINITY, u32::MAX, u32::MAX);
+    for (v, _) in done.iter().enumerate().filter(|(_, &d)| !d) {
+        for (p, _) in done.iter().enumerate().filter(|(_, &d)| d) {
+            let c = arc(p as u32, v as u32) + pi[v] + pi[p];
+            if c < best.0 {
+                best = (c, v as u32, p as u32);
+            }
+        }
+    }
+    best
+}
+
+fn add_edge(g: &mut Graph, a: u32, b: u32, c: Cost) {
+    for (x, y) in [(a, b), (b, a)] {
+        let at = g.off[x as usize + 1] as usize;
+        g.to.insert(at, y);
+        g.cost.insert(at, c);
+        for o in &mut g.off[x as usize + 1..] {
+            *o += 1;
+        }
+    }
+}
+
+/// Steps without a better bound before the step factor halves.
+const PATIENCE: usize = 10;
+
+/// Subgradient ascent on the 1-tree bound (Held and Karp): π moves along the degree excess
+/// (0.7 of this step's and 0.3 of the last, as in Helsgaun's implementation) by Polyak's step
+/// λ (ub − w) / |d|²; after `PATIENCE` steps without a better bound λ halves and the search
+/// goes back to the best π. Returns the best π found in at most `steps` steps.
+fn ascent(g: &mut Graph, n: usize, steps: usize, ub: Cost, arc: &impl Fn(u32, u32) -> Cost) -> Vec<Cost> {
+    let mut pi = vec![0.0; n];
+    let tree = prim(g, &pi, arc);
+    let excess = |t: &Tree| t.degree.iter().map(|&d| d as f64 - 2.0).collect::<Vec<f64>>();
+    let mut w = tree.cost;
+    let mut v = excess(&tree);
+    let mut last_v = v.clone();
+    let (mut best_w, mut best_pi, mut best_v) = (w, pi.clone(), v.clone());
+    let mut lambda = 1.0;
+    let mut since = 0;
+    let mut d = vec![0.0; n];
+    for _ in 0..steps {
+        for i in 0..n {
+            d[i] = 0.7 * v[i] + 0.3 * last_v[i];
+        }
+        let norm: f64 = d.iter().map(|x| x * x).sum();
+        if norm == 0.0 || lambda < 1e-6 {
+            break; // a tour (the bound is optimal), or the steps no longer move
+        }
+        let t = lambda * (ub - w).max(0.0) / norm;
+        for i in 0..n {
+            pi[i] += t * d[i];
+        }
+        last_v.copy_from_slice(&v);
+        let tree = prim(g, &pi, arc);
+        w = tree.cost - 2.0 * pi.iter().sum::<f64>();
+        v = excess(&tree);
+        if w > best_w + 1e-12 * best_w.abs() {
+            best_w = w;
+            best_pi.copy_from_slice(&pi);
+            best_v.copy_from_slice(&v);
+            since = 0;
+        } else {
+            since += 1;
+            if since >= PATIENCE {
+                lambda *= 0.5;
+                since = 0;
+                pi.copy_from_slice(&best_pi);
+                v.copy_from_slice(&best_v);
+                last_v.copy_from_slice(&best_v);
+                w = best_w;
+            }
+        }
+    }
+    best_pi
+}
+
+/// The `k` lowest-α neighbours of every node, each list sorted by plain cost, computed on
+/// `threads` threads (the answer does not depend on how many).
+fn lowest_alpha(
+    n: usize,
+    tree: &Tree,
+    pi: &[Cost],
+    k: usize,
+    threads: usize,
+    arc: &(impl Fn(u32, u32) -> Cost + Sync),
+) -> Vec<Vec<u32>> {
+    let threads = threads.clamp(1, 64).min(n);
+    if threads == 1 {
+        return alpha_rows(0..n as u32, n, tree, pi, k, arc);
+    }
+    let chunk = n.div_ceil(threads) as u32;
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads as u32)
+            .map(|t| {
+                let rows = (t * chunk).min(n as u32)..((t + 1) * chunk).min(n as u32);
+                s.spawn(move || alpha_rows(rows, n, tree, pi, k, arc))
+            })
+            .collect();
+        handles.into_iter().flat_map(|h| h.join().expect("α thread panicked")).collect()
+    })
+}
+
+/// Candidate lists of the nodes in `rows`. β(i,j), the dearest tree edge on the path from i to
+/// j, comes for every j in one pass over the tree in Prim's order (parents first) after marking
+/// i's path to the root.
+fn alpha_rows(
+    rows: std::ops::Range<u32>,
+    n: usize,
+    tree: &Tree,
+    pi: &[Cost],
+    k: usize,
+    arc: &impl Fn(u32, u32) -> Cost,
+) -> Vec<Vec<u32>> {
+    let k = k.min(n - 1);
+    let root = tree.order[0];
+    let pc = |a: u32, b: u32| arc(a, b) + pi[a as usize] + pi[b as usize];
+    let mut beta = vec![Cost::NEG_INFINITY; n];
+    let mut mark = vec![u32::MAX; n];
+    let mut lists = Vec::with_capacity(rows.len());
+    let mut best: Vec<(Cost, Cost, u32)> = Vec::with_capacity(k + 1);
+    for i in rows {
+        beta[i as usize] = Cost::NEG_INFINITY;
+        mark[i as usize] = i;
+        let mut u = i;
+        while u != root {
+            let d = tree.parent[u as usize];
+            beta[d as usize] = beta[u as usize].max(pc(u, d));
+            mark[d as usize] = i;
+            u = d;
+        }
+        best.clear();
+        for &j in &tree.order {
+            if mark[j as usize] != i {
+                let d = tree.parent[j as usize];
+                beta[j as usize] = beta[d as usize].max(pc(j, d));
+            }
+            if j == i {
+                continue;
+            }
+            let c = arc(i, j);
+            let a = c + pi[i as usize] + pi[j as usize] - beta[j as usize];
+            if best.len() == k && !better((a, c, j), best[k - 1]) {
+                continue;
+            }
+            let at = best.iter().position(|&b| better((a, c, j), b)).unwrap_or(best.len());
+            best.insert(at, (a, c, j));
+            best.truncate(k);
+        }
+        best.sort_by(|x, y| x.1.total_cmp(&y.1).then(x.2.cmp(&y.2)));
+        lists.push(best.iter().map(|b| b.2).collect());
+    }
+    lists
+}
+
+/// Lower α first, then lower cost, then lower id.
+fn better(x: (Cost, Cost, u32), y: (Cost, Cost, u32)) -> bool {
+    x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2)) == Ordering::Less
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64Mcg;
+
+    use super::*;
+    use crate::cost::{Metric, PointCost, StateId};
+    use crate::exact::solve_exact;
+    use crate::model::{Mode, Problem};
+
+    fn random_tour_problem(n: usize, seed: u64) -> Problem<PointCost> {
+        let mut rng = Pcg64Mcg::seed_from_u64(seed);
+        let pts: Vec<[f64; 3]> = (0..n).map(|_| [rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0), 0.0]).collect();
+        let mut b = Problem::builder(PointCost::new(pts, Metric::Euclidean));
+        for k in 0..n as u32 {
+            b.task(vec![Mode::point(StateId(k))]);
+        }
+        b.build().unwrap()
+    }
+
+    /// Cost of a minimum spanning tree of the complete graph under the penalised costs that
+    /// must contain the edge (i, j) (Kruskal from that edge), or without a forced edge.
+    fn forced_mst(n: usize, c: &dyn Fn(u32, u32) -> Cost, forced: Option<(u32, u32)>) -> Cost {
+        let mut edges: Vec<(Cost, u32, u32)> = Vec::new();
+        for a in 0..n as u32 {
+            for b in a + 1..n as u32 {
+                edges.push((c(a, b), a, b));
+            }
+        }
+        edges.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let mut root: Vec<usize> = (0..n).collect();
+        fn find(r: &mut [usize], x: usize) -> usize {
+            let mut x = x;
+            while r[x] != x {
+                r[x] = r[r[x]];
+                x = r[x];
+            }
+            x
+        }
+        let mut total = 0.0;
+        if let Some((i, j)) = forced {
+            total += c(i, j);
+            root[i as usize] = j as usize;
+        }
+        for (w, a, b) in edges {
+            let (ra, rb) = (find(&mut root, a as usize), find(&mut root, b as usize));
+            if ra != rb {
+                root[ra] = rb;
+                total += w;
+            }
+        }
+        total
+    }
+
+    /// The ascent's bound never exceeds the optimal tour (it is a Held–Karp lower bound), and
+    /// the α-values behind the lists are what forcing each edge into the minimum spanning tree
+    /// costs, checked against Kruskal with that edge forced on a complete graph.
+    #[test]
+    fn bound_is_below_the_optimum_and_alpha_matches_forced_trees() {
+        for seed in 0..20u64 {
+            let n = 9 + (seed % 4) as usize;
+            let p = random_tour_problem(n, seed);
+            let net = Net::new(&p);
+            let nb = Neighbors::build(&net, n - 1);
+            let arc = |a: u32, b: u32| net.arc(a, 0, b, 0);
+            let opt = solve_exact(&p).unwrap().unwrap().cost;
+            let mut g = sparse_graph(n, &nb, &arc);
+            let pi = ascent(&mut g, n, 200, opt * 1.2, &arc);
+            let tree = prim(&mut g, &pi, &arc);
+            let bound = tree.cost - 2.0 * pi.iter().sum::<f64>();
+            assert!(bound <= opt + 1e-6 * opt, "seed {seed}: bound {bound} above the optimum {opt}");
+            assert!(bound >= 0.8 * opt, "seed {seed}: bound {bound} far below the optimum {opt}");
+
+            let pc = |a: u32, b: u32| arc(a, b) + pi[a as usize] + pi[b as usize];
+            let mst = forced_mst(n, &pc, None);
+            let k = 4;
+            let lists = lowest_alpha(n, &tree, &pi, k, 2, &arc);
+            for i in 0..n as u32 {
+                let mut want: Vec<(Cost, Cost, u32)> = (0..n as u32)
+                    .filter(|&j| j != i)
+                    .map(|j| (forced_mst(n, &pc, Some((i, j))) - mst, arc(i, j), j))
+                    .collect();
+                want.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2)));
+                // the k-th and (k+1)-th α may tie within rounding: compare α-values, not ids
+                let got: Vec<Cost> = {
+                    let mut a: Vec<Cost> =
+                        lists[i as usize].iter().map(|&j| forced_mst(n, &pc, Some((i, j))) - mst).collect();
+                    a.sort_by(f64::total_cmp);
+                    a
+                };
+                for (g, w) in got.iter().zip(&want) {
+                    assert!((g - w.0).abs() <= 1e-6 * opt, "seed {seed} node {i}: α {got:?} want {want:?}");
+                }
+                assert_eq!(got.len(), k);
+            }
+        }
+    }
+
+    /// The lists keep the nearest neighbours beside the lowest-α ones, sorted by cost.
+    #[test]
+    fn lists_hold_the_nearest_and_are_sorted_by_cost() {
+        let p = random_tour_problem(300, 7);
+        let net = Net::new(&p);
+        let nb = Neighbors::build(&net, 10);
+        let lists = candidates(&net, &nb, 100, 1e9, 2).expect("a symmetric tour");
+        for v in 0..300u32 {
+            let l = lists.out(v);
+            assert!(l.len() >= ALPHA_K && l.len() <= ALPHA_K + NEAREST_KEPT);
+            for &u in nb.out(v).iter().take(NEAREST_KEPT) {
+                assert!(l.contains(&u), "node {v} lost near neighbour {u}");
+            }
+            for w in l.windows(2) {
+                assert!(net.arc(v, 0, w[0], 0) <= net.arc(v, 0, w[1], 0));
+            }
+            assert!(!l.contains(&v));
+        }
+    }
+}
