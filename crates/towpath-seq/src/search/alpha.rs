@@ -95,8 +95,8 @@ pub(crate) fn plan(n: usize, threads: usize, seconds: Option<f64>) -> Option<usi
 /// Candidate lists of the [`ALPHA_K`] lowest-α neighbours of each node and its
 /// [`NEAREST_KEPT`] nearest in `nb`, sorted by cost as the local search expects; the ascent
 /// takes at most `steps` steps over the graph of `nb`, and `ub` is the cost of a tour (for the
-/// step length). `None` unless the instance is a closed tour with
-/// one mode per task and symmetric costs.
+/// step length). `None` unless the instance is a closed tour with one mode per task and
+/// symmetric costs.
 pub(crate) fn candidates<C: CostModel>(
     net: &Net<C>,
     nb: &Neighbors,
@@ -116,6 +116,7 @@ pub(crate) fn candidates<C: CostModel>(
     let pi = ascent(&mut g, n, steps, ub, &arc);
     let tree = prim(&mut g, &pi, &arc);
     let mut lists = lowest_alpha(n, &tree, &pi, ALPHA_K, threads, &arc);
+    // add the nearest, then order by cost (the one sort the lists get)
     for (v, list) in lists.iter_mut().enumerate() {
         let v = v as u32;
         for &u in nb.out(v).iter().take(NEAREST_KEPT) {
@@ -310,8 +311,8 @@ fn ascent(g: &mut Graph, n: usize, steps: usize, ub: Cost, arc: &impl Fn(u32, u3
     best_pi
 }
 
-/// The `k` lowest-α neighbours of every node, each list sorted by plain cost, computed on
-/// `threads` threads (the answer does not depend on how many).
+/// The `k` lowest-α neighbours of every node, lowest α first, computed on `threads` threads
+/// (the answer does not depend on how many).
 fn lowest_alpha(
     n: usize,
     tree: &Tree,
@@ -382,7 +383,6 @@ fn alpha_rows(
             best.insert(at, (a, c, j));
             best.truncate(k);
         }
-        best.sort_by(|x, y| x.1.total_cmp(&y.1).then(x.2.cmp(&y.2)));
         lists.push(best.iter().map(|b| b.2).collect());
     }
     lists
