@@ -192,7 +192,34 @@ impl<'p, C: CostModel> Net<'p, C> {
                     && net.exit[net.mode_base[t] as usize] == StateId(t as u32)
             });
         net.tabulate();
+        net.reversible_under_precedence();
         net
+    }
+
+    /// Marks a one-mode instance with precedence as reversal-symmetric when its tabulated arcs
+    /// are symmetric except between tasks tied directly by precedence (as in TSPLIB's prob.100,
+    /// whose matrix is symmetric but for the -1 entries that encode the precedence): an arc
+    /// against a precedence edge is never used by a feasible route, so reversing a stretch with
+    /// no precedence inside leaves the stretch's cost unchanged. `plain_symmetric` stays false
+    /// (arcs are priced in their direction).
+    fn reversible_under_precedence(&mut self) {
+        if self.reversal_symmetric || !self.has_prec || self.multi_mode || self.has_groups || self.dense_w == 0 {
+            return;
+        }
+        let w = self.dense_w;
+        let node = |i: usize| if i + 1 == w && self.depot != u32::MAX { self.depot } else { i as u32 };
+        for i in 0..w {
+            for j in i + 1..w {
+                if self.dense[i * w + j] == self.dense[j * w + i] {
+                    continue;
+                }
+                let (a, b) = (node(i), node(j));
+                if !self.successors(a).contains(&b) && !self.successors(b).contains(&a) {
+                    return;
+                }
+            }
+        }
+        self.reversal_symmetric = true;
     }
 
     /// Fills the dense arc table when it is small enough to pay off.
