@@ -72,6 +72,8 @@ pub(crate) struct Ils<'a, 'p, C> {
     /// Use ruin-and-recreate kicks (for precedence, groups or modes, where double bridges
     /// are often infeasible or blind to modes).
     rebuild: bool,
+    /// Kick with a four-arc double bridge (the local search has sequential 3-opt steps).
+    bridge4: bool,
 }
 
 impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
@@ -79,7 +81,8 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         let mm = net.p.max_modes();
         let dp_each_kick = net.multi_mode && net.n * mm * mm <= 20_000;
         let rebuild = net.n <= REBUILD_UP_TO && (net.has_prec || net.has_groups || net.multi_mode);
-        Ils { net, nb, eps, dp_each_kick, rebuild }
+        let bridge4 = super::local::uses_or3(net);
+        Ils { net, nb, eps, dp_each_kick, rebuild, bridge4 }
     }
 
     /// Brings a tour to a local optimum of the moves and the mode DP.
@@ -208,6 +211,9 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         let net = self.net;
         let n = tour.len();
         let max_len = (n / 2).clamp(1, KICK_SEGMENT);
+        if self.bridge4 && n >= 8 {
+            return self.double_bridge(tour, rng, ls);
+        }
         for _attempt in 0..20 {
             let l1 = rng.gen_range(1..=max_len);
             let l2 = rng.gen_range(1..=max_len);
@@ -256,6 +262,40 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
             return true;
         }
         false
+    }
+
+    /// The double bridge of Martin, Otto and Felten on three short consecutive segments: A B C D
+    /// becomes A D C B, four arcs changed in two alternating cycles, which no sequential move
+    /// undoes in one step. Plain symmetric one-mode tours only (no precedence, groups or modes).
+    fn double_bridge(&self, tour: &mut Tour, rng: &mut Pcg64Mcg, ls: &mut LocalSearch<'_, '_, C>) -> bool {
+        let net = self.net;
+        let n = tour.len();
+        let max_len = ((n - 2) / 3).clamp(1, KICK_SEGMENT);
+        let (l1, l2, l3) = (rng.gen_range(1..=max_len), rng.gen_range(1..=max_len), rng.gen_range(1..=max_len));
+        let i = rng.gen_range(1..=n - l1 - l2 - l3);
+        let (j, k, l) = (i + l1 - 1, i + l1 + l2 - 1, i + l1 + l2 + l3 - 1);
+        let (p, a, b, c, d, e, f, q) = (
+            tour.seq[i - 1],
+            tour.seq[i],
+            tour.seq[j],
+            tour.seq[j + 1],
+            tour.seq[k],
+            tour.seq[k + 1],
+            tour.seq[l],
+            tour.next_of_pos(l),
+        );
+        let old = tour.arc(net, p, a) + tour.arc(net, b, c) + tour.arc(net, d, e) + tour.arc(net, f, q);
+        let new = tour.arc(net, p, e) + tour.arc(net, f, c) + tour.arc(net, d, a) + tour.arc(net, b, q);
+        // B C D reversed as a whole, then each piece turned back
+        tour.reverse(i, l);
+        tour.reverse(i, i + l3 - 1);
+        tour.reverse(i + l3, i + l3 + l2 - 1);
+        tour.reverse(i + l3 + l2, l);
+        tour.cost += new - old;
+        for x in [p, a, b, c, d, e, f, q] {
+            ls.push(x);
+        }
+        true
     }
 
     /// Ruin and recreate: removes a few neighbouring tasks and puts each back at its cheapest
