@@ -63,3 +63,48 @@ fn point_modes_from_start() {
     let p = b.build().unwrap();
     run(&p, 300);
 }
+
+/// Plain symmetric one-mode tours and paths, where Lin–Kernighan chains take sequential 3-opt
+/// steps and the kicks are four-arc double bridges: on small instances solved exactly (closed,
+/// open with a free end, open from a start point), the answer is feasible, priced as the checker
+/// prices it, and optimal on (nearly) all.
+#[test]
+fn plain_symmetric_tours_match_the_exact_optimum() {
+    let mut misses = Vec::new();
+    let mut total = 0;
+    for seed in 0..90u64 {
+        let n = 8 + (seed % 5) as usize;
+        let pts = points(n + 1, 100 + seed);
+        let mut b = Problem::builder(PointCost::new(pts, Metric::EuclideanNint));
+        b.point_tasks(n);
+        match seed % 3 {
+            0 => {}
+            1 => {
+                b.end(End::Free);
+            }
+            _ => {
+                b.start(StateId(n as u32)).end(End::Free);
+            }
+        }
+        let p = b.build().unwrap();
+        let exact = solve_exact(&p).unwrap().unwrap();
+        let exact_cost = check(&p, &exact.steps).unwrap();
+        let opts = SolveOptions {
+            time_limit: None,
+            iterations: Some(300),
+            threads: 1,
+            seed,
+            exact_up_to: 0,
+            ..Default::default()
+        };
+        let r = solve(&p, &opts).unwrap();
+        let c = check(&p, &r.solution.steps).unwrap();
+        assert!((c - r.solution.cost).abs() < 1e-6, "seed {seed}");
+        assert!(c >= exact_cost - 1e-6, "seed {seed}: {c} below the optimum {exact_cost}");
+        total += 1;
+        if c > exact_cost + 1e-6 {
+            misses.push(format!("seed {seed} (n {n}): {c} vs {exact_cost}"));
+        }
+    }
+    assert!(misses.len() * 100 <= total, "misses:\n{}", misses.join("\n"));
+}
