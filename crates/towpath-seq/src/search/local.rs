@@ -956,8 +956,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             // stretches are reversed tentatively)
             let len = hi - lo + 1;
             let len = if net.wrap_ok { len.min(tour.len() - len) } else { len };
-            let goes_deeper =
-                len <= self.lk_max_tentative && (deeper.len() < cap || deeper.last().is_some_and(|d| g2 > d.g2));
+            let goes_deeper = len <= self.lk_max_tentative && ranks(deeper, cap, g2);
             if total >= close_total && !goes_deeper {
                 continue;
             }
@@ -1005,7 +1004,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         }
         // positions along the traversal direction, measured from t2
         let n = tour.len();
-        let (p2, p3) = (tour.pos[t2 as usize] as usize, tour.pos[t3 as usize] as usize);
+        let p2 = tour.pos[t2 as usize] as usize;
         let along = |x: u32| {
             let px = tour.pos[x as usize] as usize;
             if forward {
@@ -1014,7 +1013,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 (p2 + n - px) % n
             }
         };
-        let span = if forward { (p3 + n - p2) % n } else { (p2 + n - p3) % n };
+        let span = along(t3);
         let g2 = g1 + net.arc(t3, 0, t4, 0);
         // one mode and symmetric: the lists' lower bounds are the arcs' costs
         for (&t5, &c45) in self.nb.out(t4).iter().zip(self.nb.out_lb(t4)).take(OR3_BREADTH) {
@@ -1027,8 +1026,8 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 continue; // t5 must lie in t2..t3, and t5 = t3 would add t3–t4 back
             }
             // t6 after t5 (segment exchange) or before it (double reversal), both inside t2..t3
-            for t6 in [succ(t5), pred(t5)] {
-                if t6 == t1 || (t6 == succ(t5) && a5 == span) {
+            for (t6, after) in [(succ(t5), true), (pred(t5), false)] {
+                if t6 == t1 || (after && a5 == span) {
                     continue;
                 }
                 let g4 = g3 + net.arc(t5, 0, t6, 0);
@@ -1038,7 +1037,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                     *close_total = total;
                     *close = Some(step);
                 }
-                if deeper.len() < cap || deeper.last().is_some_and(|d| g4 > d.g2) {
+                if ranks(deeper, cap, g4) {
                     offer(deeper, cap, step);
                 }
             }
@@ -1131,6 +1130,11 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
     }
 }
 
+/// Whether a step of partial gain `g2` belongs among the `cap` largest kept in `deeper`.
+fn ranks(deeper: &[LkStep], cap: usize, g2: Cost) -> bool {
+    deeper.len() < cap || deeper.last().is_some_and(|d| g2 > d.g2)
+}
+
 /// Puts a step among the `cap` largest partial gains, best first.
 fn offer(deeper: &mut Vec<LkStep>, cap: usize, step: LkStep) {
     let at = deeper.iter().position(|d| step.g2 > d.g2).unwrap_or(deeper.len());
@@ -1149,12 +1153,12 @@ mod tests {
     use crate::cost::{Metric, PointCost, StateId};
     use crate::model::{Mode, Problem};
 
-    fn edges(tour: &Tour) -> BTreeSet<(u32, u32)> {
-        (0..tour.len()).map(|i| (tour.seq[i].min(tour.next_of_pos(i)), tour.seq[i].max(tour.next_of_pos(i)))).collect()
-    }
-
     fn key(a: u32, b: u32) -> (u32, u32) {
         (a.min(b), a.max(b))
+    }
+
+    fn edges(tour: &Tour) -> BTreeSet<(u32, u32)> {
+        (0..tour.len()).map(|i| key(tour.seq[i], tour.next_of_pos(i))).collect()
     }
 
     /// Every sequential 3-opt step the chain can take gives the tour whose arcs are the old
