@@ -28,10 +28,21 @@ const SWAP_WINDOW: usize = 64;
 /// Deepest chain of reversals in a Lin–Kernighan move.
 const LK_DEPTH: usize = 6;
 
+/// Deepest chain where the steps may be sequential 3-opt moves (plain symmetric one-mode tours,
+/// [`uses_or3`]); those chains are greedy at every level. At 10 s on 2 cores, interleaved runs of
+/// seeds 4-8: pcb3038 0.30 % → 0.14 % and fnl4461 0.15 % → 0.13 % above the optimum by median
+/// (depth 6 with three first-level alternatives before); depth 12 gave 0.26 / 0.15 %, 18 and 50
+/// were worse than 25 over seeds 1-3. Ten TSPLIB instances of 532-2392 nodes at 5 s, seeds 1-2:
+/// gap sums 1.37 % → 1.01 % (depth 12: 0.81 %; d1291 is bimodal). A deeper chain is dearer only
+/// when it fails, and then only by its tentative reversals.
+const LK_DEPTH_OR3: usize = 25;
+
 /// Alternatives tried at the first level of a Lin–Kernighan move on tours of at least
-/// `LK_BREADTH_FROM` nodes (deeper levels, and every level on smaller tours, are greedy).
-/// Measured at 10 s on 2 cores, 6 seeds: pcb3038 0.31 % → 0.25 % and fnl4461 0.37 % → 0.29 %
-/// above the optimum with 3 alternatives; pr1002 did worse (0.25 % → 0.34 %).
+/// `LK_BREADTH_FROM` nodes without 3-opt steps (deeper levels, and every level on smaller
+/// tours, are greedy). Measured at 10 s on 2 cores, 6 seeds, with chains of 2-opt and 3-opt
+/// steps 6 deep: pcb3038 0.31 % → 0.25 % and fnl4461 0.37 % → 0.29 % above the optimum with 3
+/// alternatives; pr1002 did worse (0.25 % → 0.34 %). With 25-deep chains (`LK_DEPTH_OR3`) one
+/// alternative did better (seeds 1-3: 0.32 % against 0.23 % for the two instances summed).
 const LK_BREADTH: usize = 3;
 const LK_BREADTH_FROM: usize = 2000;
 /// Above this size the first level stays greedy: on 100,000 random strokes (two modes each) the
@@ -99,6 +110,9 @@ pub(crate) struct LocalSearch<'a, 'p, C> {
     pub moves: u64,
     /// Endpoints of the arcs changed by the current Lin–Kernighan chain.
     lk_touched: Vec<u32>,
+    /// `touch_mark[v] == touch_stamp` while `v` is in `lk_touched`.
+    touch_mark: Vec<u32>,
+    touch_stamp: u32,
     /// Scratch list of (position, node) candidates for the segment exchange.
     cands: Vec<(usize, u32)>,
     /// Alternatives tried at the first level of a Lin–Kernighan move.
@@ -112,6 +126,8 @@ pub(crate) struct LocalSearch<'a, 'p, C> {
     lk_max_tentative: usize,
     /// Lin–Kernighan steps may be sequential 3-opt moves (plain symmetric one-mode tours).
     lk_or3: bool,
+    /// Deepest chain of a Lin–Kernighan move (`LK_DEPTH`, or `LK_DEPTH_OR3` with 3-opt steps).
+    lk_depth: usize,
 }
 
 /// Whether Or-opt and the segment exchange apply the positive-gain criterion: a move whose
@@ -160,12 +176,19 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             cut: false,
             moves: 0,
             lk_touched: Vec::new(),
+            touch_mark: vec![0; net.n],
+            touch_stamp: 1,
             cands: Vec::new(),
-            lk_breadth: if (LK_BREADTH_FROM..=LK_BREADTH_UP_TO).contains(&net.n) { LK_BREADTH } else { 1 },
+            lk_breadth: if !uses_or3(net) && (LK_BREADTH_FROM..=LK_BREADTH_UP_TO).contains(&net.n) {
+                LK_BREADTH
+            } else {
+                1
+            },
             lk_max_tentative: if net.n > LK_BREADTH_UP_TO { LK_TENTATIVE_HUGE } else { usize::MAX },
             lk_alts: Vec::new(),
             lk_one: Vec::new(),
             lk_or3: uses_or3(net),
+            lk_depth: if uses_or3(net) { LK_DEPTH_OR3 } else { LK_DEPTH },
         }
     }
 
@@ -818,9 +841,9 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             let start = tour.mark();
             let t2 = if first_forward { tour.next(t1) } else { tour.prev(t1) };
             let g = if first_forward { tour.arc(self.net, t1, t2) } else { tour.arc(self.net, t2, t1) };
-            self.lk_touched.clear();
-            self.lk_touched.push(t1);
-            self.lk_touched.push(t2);
+            self.touch_reset();
+            self.touch(t1);
+            self.touch(t2);
             // first level: close at once if that improves, else go deeper from each of the
             // best few steps in turn
             alts.clear();
@@ -840,7 +863,9 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 tour.undo_to(start);
                 let again = tour.mark();
                 debug_assert_eq!(again, start);
-                self.lk_touched.truncate(2);
+                self.touch_reset();
+                self.touch(t1);
+                self.touch(t2);
             }
             tour.undo_to(start);
         }
@@ -865,7 +890,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
     fn lk_deeper(&mut self, tour: &mut Tour, t1: u32, mut t2: u32, mut g: Cost, mut so_far: Cost) -> bool {
         let mut one = std::mem::take(&mut self.lk_one);
         let mut improved = false;
-        for depth in 2..=LK_DEPTH {
+        for depth in 2..=self.lk_depth {
             one.clear();
             if let Some(c) = self.lk_level(tour, t1, t2, g, so_far, depth, 1, &mut one) {
                 self.lk_apply(tour, t1, &c);
@@ -873,7 +898,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 break;
             }
             let Some(&step) = one.first() else { break };
-            if depth == LK_DEPTH {
+            if depth == self.lk_depth {
                 break;
             }
             self.lk_apply(tour, t1, &step);
@@ -907,7 +932,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         // with one mode on a plain symmetric tour the lists' lower bounds are the arcs' costs
         let exact_lb = net.plain_symmetric && !net.multi_mode;
         for (&t3, &lb) in self.nb.out(t2).iter().zip(self.nb.out_lb(t2)) {
-            if t3 == t1 || (depth > 1 && self.lk_touched.contains(&t3)) {
+            if t3 == t1 || (depth > 1 && self.touch_mark[t3 as usize] == self.touch_stamp) {
                 continue;
             }
             // the new arc joins t3 to t2 turned round (t2 ends the reversed stretch)
@@ -1084,12 +1109,29 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             self.reverse_short_way(tour, step.lo, step.hi);
         } else {
             self.or3_apply(tour, t1, step);
-            self.lk_touched.push(step.t5);
-            self.lk_touched.push(step.t6);
+            self.touch(step.t5);
+            self.touch(step.t6);
         }
         tour.cost += step.step;
-        self.lk_touched.push(step.t3);
-        self.lk_touched.push(step.t4);
+        self.touch(step.t3);
+        self.touch(step.t4);
+    }
+
+    /// Notes a node as an endpoint of an arc the current chain changed.
+    #[inline]
+    fn touch(&mut self, v: u32) {
+        self.lk_touched.push(v);
+        self.touch_mark[v as usize] = self.touch_stamp;
+    }
+
+    /// Starts a new chain: no node touched.
+    fn touch_reset(&mut self) {
+        self.lk_touched.clear();
+        self.touch_stamp = self.touch_stamp.wrapping_add(1);
+        if self.touch_stamp == 0 {
+            self.touch_mark.fill(0);
+            self.touch_stamp = 1;
+        }
     }
 
     /// Reverses positions `lo..=hi`, or the rest of the cycle when that is shorter and allowed
