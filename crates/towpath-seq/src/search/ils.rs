@@ -109,6 +109,18 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         ls.moves
     }
 
+    /// Brings a tour back to a local optimum after changes at `nodes` (only those are looked
+    /// at first). Returns false when the deadline cut the search short.
+    pub fn polish(&self, tour: &mut Tour, nodes: &[u32], deadline: Option<Instant>) -> bool {
+        let mut ls = LocalSearch::new(self.net, self.nb, self.eps);
+        ls.deadline = deadline;
+        for &v in nodes {
+            ls.push(v);
+        }
+        ls.run(tour);
+        !ls.cut
+    }
+
     /// Runs kicks on a chain's state and returns the kicks done.
     pub fn run(&self, state: &mut Chain, budget: Budget, cancel: Option<&AtomicBool>) -> u64 {
         let Chain { cur, best, rng, stagnation } = state;

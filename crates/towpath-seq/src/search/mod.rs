@@ -5,6 +5,7 @@ mod alpha;
 mod construct;
 mod ils;
 mod local;
+mod merge;
 mod modes;
 mod neighbors;
 mod net;
@@ -233,6 +234,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
             opts.time_limit.map_or(Duration::ZERO, |tl| (tl / 10).min(Duration::from_secs_f64(net.n as f64 * 20e-6)));
         d - reserve
     });
+    let merge_chains = threads > 1 && local::uses_or3(&net);
     let mut chains: Vec<ils::Chain> = (0..threads)
         .map(|t| ils::Chain::new(&best, opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ t as u64))
         .collect();
@@ -271,6 +273,20 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         for c in chains.iter() {
             if c.best.cost < best.cost - eps {
                 best.clone_from(&c.best);
+            }
+        }
+        // Where the chains' tours can be merged, the merge keeps every chain's improvements
+        // (10 s, 2 cores, interleaved seeds 9-13: pcb3038 0.134 -> 0.123 %, fnl4461 0.148 ->
+        // 0.121 % above the optimum by median; ten TSPLIB instances of 532-2392 nodes at 5 s:
+        // gap sums 1.29 -> 1.24 %, within noise).
+        if merge_chains {
+            for c in chains.iter() {
+                if let Some((seq, changed)) = merge::partition_crossover(&net, &best, &c.best, eps) {
+                    let mut child = Tour::new(&net, seq, vec![0; net.n]);
+                    if ils.polish(&mut child, &changed, search_end) && child.cost < best.cost - eps {
+                        best = child;
+                    }
+                }
             }
         }
         for c in chains.iter_mut() {
