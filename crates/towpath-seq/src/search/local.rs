@@ -162,6 +162,7 @@ struct Insertion {
 
 impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
     pub fn new(net: &'a Net<'p, C>, nb: &'a Neighbors, eps: Cost) -> Self {
+        let or3 = uses_or3(net);
         LocalSearch {
             net,
             nb,
@@ -179,16 +180,12 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             touch_mark: vec![0; net.n],
             touch_stamp: 1,
             cands: Vec::new(),
-            lk_breadth: if !uses_or3(net) && (LK_BREADTH_FROM..=LK_BREADTH_UP_TO).contains(&net.n) {
-                LK_BREADTH
-            } else {
-                1
-            },
+            lk_breadth: if !or3 && (LK_BREADTH_FROM..=LK_BREADTH_UP_TO).contains(&net.n) { LK_BREADTH } else { 1 },
             lk_max_tentative: if net.n > LK_BREADTH_UP_TO { LK_TENTATIVE_HUGE } else { usize::MAX },
             lk_alts: Vec::new(),
             lk_one: Vec::new(),
-            lk_or3: uses_or3(net),
-            lk_depth: if uses_or3(net) { LK_DEPTH_OR3 } else { LK_DEPTH },
+            lk_or3: or3,
+            lk_depth: if or3 { LK_DEPTH_OR3 } else { LK_DEPTH },
         }
     }
 
@@ -841,9 +838,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             let start = tour.mark();
             let t2 = if first_forward { tour.next(t1) } else { tour.prev(t1) };
             let g = if first_forward { tour.arc(self.net, t1, t2) } else { tour.arc(self.net, t2, t1) };
-            self.touch_reset();
-            self.touch(t1);
-            self.touch(t2);
+            self.touch_start(t1, t2);
             // first level: close at once if that improves, else go deeper from each of the
             // best few steps in turn
             alts.clear();
@@ -863,9 +858,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 tour.undo_to(start);
                 let again = tour.mark();
                 debug_assert_eq!(again, start);
-                self.touch_reset();
-                self.touch(t1);
-                self.touch(t2);
+                self.touch_start(t1, t2);
             }
             tour.undo_to(start);
         }
@@ -1124,14 +1117,16 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         self.touch_mark[v as usize] = self.touch_stamp;
     }
 
-    /// Starts a new chain: no node touched.
-    fn touch_reset(&mut self) {
+    /// Starts a new chain from the arc t1–t2: only its ends touched.
+    fn touch_start(&mut self, t1: u32, t2: u32) {
         self.lk_touched.clear();
         self.touch_stamp = self.touch_stamp.wrapping_add(1);
         if self.touch_stamp == 0 {
             self.touch_mark.fill(0);
             self.touch_stamp = 1;
         }
+        self.touch(t1);
+        self.touch(t2);
     }
 
     /// Reverses positions `lo..=hi`, or the rest of the cycle when that is shorter and allowed

@@ -36,7 +36,21 @@ pub(crate) fn partition_crossover<C: CostModel>(
     let shares = |t: &Tour, u: u32, v: u32| t.next(u) == v || t.prev(u) == v;
     let cost = |u: u32, v: u32| net.arc(u, 0, v, 0);
 
-    // Components of the arcs in one tour only (union-find over their end nodes).
+    // The arcs in one tour only, with the sign of their cost in the gain of switching from
+    // a's arcs to b's (a's own arcs count for, b's against).
+    let mut unshared: Vec<(u32, u32, Cost)> = Vec::new();
+    for (t, other, sign) in [(a, b, 1.0), (b, a, -1.0)] {
+        for i in 0..n {
+            let (u, v) = (t.seq[i], t.next_of_pos(i));
+            if !shares(other, u, v) {
+                unshared.push((u, v, sign));
+            }
+        }
+    }
+    if unshared.is_empty() {
+        return None;
+    }
+    // Their components (union-find over the end nodes) and each component's gain.
     let mut parent: Vec<u32> = (0..n as u32).collect();
     fn find(parent: &mut [u32], mut x: u32) -> u32 {
         while parent[x as usize] != x {
@@ -46,35 +60,19 @@ pub(crate) fn partition_crossover<C: CostModel>(
         }
         x
     }
-    let mut diff = false;
-    for (t, other) in [(a, b), (b, a)] {
-        for i in 0..n {
-            let (u, v) = (t.seq[i], t.next_of_pos(i));
-            if !shares(other, u, v) {
-                diff = true;
-                let (ru, rv) = (find(&mut parent, u), find(&mut parent, v));
-                if ru != rv {
-                    parent[ru as usize] = rv;
-                }
-            }
-        }
-    }
-    if !diff {
-        return None;
-    }
-    // Gain of switching each component from a's arcs to b's: a's own arcs there less b's.
-    let mut gain: Vec<Cost> = vec![0.0; n];
     let mut in_comp = vec![false; n];
-    for (t, other, sign) in [(a, b, 1.0), (b, a, -1.0)] {
-        for i in 0..n {
-            let (u, v) = (t.seq[i], t.next_of_pos(i));
-            if !shares(other, u, v) {
-                let r = find(&mut parent, u) as usize;
-                gain[r] += sign * cost(u, v);
-                in_comp[u as usize] = true;
-                in_comp[v as usize] = true;
-            }
+    for &(u, v, _) in &unshared {
+        let (ru, rv) = (find(&mut parent, u), find(&mut parent, v));
+        if ru != rv {
+            parent[ru as usize] = rv;
         }
+        in_comp[u as usize] = true;
+        in_comp[v as usize] = true;
+    }
+    let mut gain: Vec<Cost> = vec![0.0; n];
+    for &(u, v, sign) in &unshared {
+        let r = find(&mut parent, u) as usize;
+        gain[r] += sign * cost(u, v);
     }
     let mut members: Vec<Vec<u32>> = vec![Vec::new(); n];
     for v in 0..n as u32 {
@@ -83,17 +81,15 @@ pub(crate) fn partition_crossover<C: CostModel>(
             members[r].push(v);
         }
     }
-    let mut paying: Vec<usize> = (0..n).filter(|&r| gain[r] > eps && !members[r].is_empty()).collect();
-    if paying.is_empty() {
-        return None;
-    }
-    paying.sort_by(|&x, &y| gain[y].total_cmp(&gain[x]).then(x.cmp(&y)));
-    paying.truncate(MAX_TRIES);
-
-    // Every component, for pairing with a paying one that cannot switch alone.
+    // Every component, best gain first; the paying ones lead, and any may pair with a paying
+    // one that cannot switch alone.
     let mut comps: Vec<usize> = (0..n).filter(|&r| !members[r].is_empty()).collect();
     comps.sort_by(|&x, &y| gain[y].total_cmp(&gain[x]).then(x.cmp(&y)));
     comps.truncate(MAX_TRIES);
+    let paying = comps.iter().take_while(|&&r| gain[r] > eps).count();
+    if paying == 0 {
+        return None;
+    }
 
     // The child's arcs, as a's to start with.
     let mut cur: Vec<[u32; 2]> = (0..n as u32).map(|v| adj(a, v)).collect();
@@ -106,7 +102,7 @@ pub(crate) fn partition_crossover<C: CostModel>(
             cur[v as usize] = adj(t, v);
         }
     };
-    for &r in &paying {
+    for &r in &comps[..paying] {
         if done[r] {
             continue;
         }
