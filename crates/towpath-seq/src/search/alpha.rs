@@ -395,22 +395,16 @@ fn better(x: (Cost, Cost, u32), y: (Cost, Cost, u32)) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     use rand_pcg::Pcg64Mcg;
 
     use super::*;
-    use crate::cost::{Metric, PointCost, StateId};
+    use crate::cost::PointCost;
     use crate::exact::solve_exact;
-    use crate::model::{Mode, Problem};
+    use crate::model::Problem;
 
     fn random_tour_problem(n: usize, seed: u64) -> Problem<PointCost> {
-        let mut rng = Pcg64Mcg::seed_from_u64(seed);
-        let pts: Vec<[f64; 3]> = (0..n).map(|_| [rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0), 0.0]).collect();
-        let mut b = Problem::builder(PointCost::new(pts, Metric::Euclidean));
-        for k in 0..n as u32 {
-            b.task(vec![Mode::point(StateId(k))]);
-        }
-        b.build().unwrap()
+        super::super::testing::random_tour_problem(&mut Pcg64Mcg::seed_from_u64(seed), n, 100.0)
     }
 
     /// Cost of a minimum spanning tree of the complete graph under the penalised costs that

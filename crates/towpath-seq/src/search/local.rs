@@ -1187,8 +1187,7 @@ mod tests {
     use rand_pcg::Pcg64Mcg;
 
     use super::*;
-    use crate::cost::{Metric, PointCost, StateId};
-    use crate::model::{Mode, Problem};
+    use crate::search::testing::random_tour_problem;
 
     fn key(a: u32, b: u32) -> (u32, u32) {
         (a.min(b), a.max(b))
@@ -1206,12 +1205,7 @@ mod tests {
     fn sequential_three_opt_steps_make_the_priced_tour() {
         let n = 40;
         let mut rng = Pcg64Mcg::seed_from_u64(5);
-        let pts: Vec<[f64; 3]> = (0..n).map(|_| [rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0), 0.0]).collect();
-        let mut b = Problem::builder(PointCost::new(pts, Metric::Euclidean));
-        for k in 0..n as u32 {
-            b.task(vec![Mode::point(StateId(k))]);
-        }
-        let p = b.build().unwrap();
+        let p = random_tour_problem(&mut rng, n, 100.0);
         let net = Net::new(&p);
         assert!(uses_or3(&net));
         let nb = Neighbors::build(&net, 10);

@@ -146,25 +146,30 @@ pub(crate) fn partition_crossover<C: CostModel>(
     let (mut prev, mut x) = (u32::MAX, net.anchor);
     for _ in 0..n {
         seq.push(x);
-        let [p, q] = cur[x as usize];
-        let nx = if p != prev { p } else { q };
-        prev = x;
-        x = nx;
+        (prev, x) = (x, step(&cur, prev, x));
     }
     Some((seq, switched))
+}
+
+/// The node after `x` on a walk along the arcs (two per node) that came from `prev`.
+#[inline]
+fn step(adj: &[[u32; 2]], prev: u32, x: u32) -> u32 {
+    let [p, q] = adj[x as usize];
+    if p != prev {
+        p
+    } else {
+        q
+    }
 }
 
 /// Whether the arcs (two per node) form one cycle through every node.
 fn one_cycle(adj: &[[u32; 2]]) -> bool {
     let n = adj.len();
     let (mut prev, mut x) = (u32::MAX, 0u32);
-    for step in 1..=n {
-        let [p, q] = adj[x as usize];
-        let nx = if p != prev { p } else { q };
-        prev = x;
-        x = nx;
+    for k in 1..=n {
+        (prev, x) = (x, step(adj, prev, x));
         if x == 0 {
-            return step == n;
+            return k == n;
         }
     }
     false
@@ -176,8 +181,7 @@ mod tests {
     use rand_pcg::Pcg64Mcg;
 
     use super::*;
-    use crate::cost::{Metric, PointCost, StateId};
-    use crate::model::{Mode, Problem};
+    use crate::search::testing::random_tour_problem;
 
     /// Two tours that differ by improving 2-opt moves in different places merge into one tour
     /// holding both improvements: a single cycle through every node, anchor first, costing what
@@ -186,13 +190,7 @@ mod tests {
     fn independent_improvements_of_two_tours_are_both_kept() {
         let n = 200;
         let mut rng = Pcg64Mcg::seed_from_u64(3);
-        let pts: Vec<[f64; 3]> =
-            (0..n).map(|_| [rng.gen_range(0.0..1000.0), rng.gen_range(0.0..1000.0), 0.0]).collect();
-        let mut builder = Problem::builder(PointCost::new(pts, Metric::Euclidean));
-        for k in 0..n as u32 {
-            builder.task(vec![Mode::point(StateId(k))]);
-        }
-        let p = builder.build().unwrap();
+        let p = random_tour_problem(&mut rng, n, 1000.0);
         let net = Net::new(&p);
         let mut merged_some = 0;
         for trial in 0..50 {
@@ -243,12 +241,7 @@ mod tests {
     fn merges_of_unrelated_tours_are_tours() {
         let n = 60;
         let mut rng = Pcg64Mcg::seed_from_u64(9);
-        let pts: Vec<[f64; 3]> = (0..n).map(|_| [rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0), 0.0]).collect();
-        let mut builder = Problem::builder(PointCost::new(pts, Metric::Euclidean));
-        for k in 0..n as u32 {
-            builder.task(vec![Mode::point(StateId(k))]);
-        }
-        let p = builder.build().unwrap();
+        let p = random_tour_problem(&mut rng, n, 100.0);
         let net = Net::new(&p);
         let shuffled = |rng: &mut Pcg64Mcg| {
             let mut s: Vec<u32> = (0..n as u32).collect();

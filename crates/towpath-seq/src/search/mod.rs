@@ -11,6 +11,27 @@ mod neighbors;
 mod net;
 mod tour;
 
+/// Test problems shared by the search modules' tests.
+#[cfg(test)]
+pub(crate) mod testing {
+    use rand::Rng;
+    use rand_pcg::Pcg64Mcg;
+
+    use crate::cost::{Metric, PointCost, StateId};
+    use crate::model::{Mode, Problem};
+
+    /// A closed tour through `n` random points of a `side` × `side` square (Euclidean, one
+    /// mode per task), the points drawn from `rng`.
+    pub(crate) fn random_tour_problem(rng: &mut Pcg64Mcg, n: usize, side: f64) -> Problem<PointCost> {
+        let pts: Vec<[f64; 3]> = (0..n).map(|_| [rng.gen_range(0.0..side), rng.gen_range(0.0..side), 0.0]).collect();
+        let mut b = Problem::builder(PointCost::new(pts, Metric::Euclidean));
+        for k in 0..n as u32 {
+            b.task(vec![Mode::point(StateId(k))]);
+        }
+        b.build().expect("a point per task is a valid problem")
+    }
+}
+
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
