@@ -11,6 +11,8 @@ use super::net::{Net, NO_REV};
 use super::tour::Tour;
 use crate::cost::{Cost, CostModel};
 
+mod lk3;
+
 /// Longest segment Or-opt moves.
 const MAX_SEGMENT: usize = 3;
 
@@ -28,21 +30,11 @@ const SWAP_WINDOW: usize = 64;
 /// Deepest chain of reversals in a Lin–Kernighan move.
 const LK_DEPTH: usize = 6;
 
-/// Deepest chain where the steps may be sequential 3-opt moves (plain symmetric one-mode tours,
-/// [`uses_or3`]); those chains are greedy at every level. At 10 s on 2 cores, interleaved runs of
-/// seeds 4-8: pcb3038 0.30 % → 0.14 % and fnl4461 0.15 % → 0.13 % above the optimum by median
-/// (depth 6 with three first-level alternatives before); depth 12 gave 0.26 / 0.15 %, 18 and 50
-/// were worse than 25 over seeds 1-3. Ten TSPLIB instances of 532-2392 nodes at 5 s, seeds 1-2:
-/// gap sums 1.37 % → 1.01 % (depth 12: 0.81 %; d1291 is bimodal). A deeper chain is dearer only
-/// when it fails, and then only by its tentative reversals.
-const LK_DEPTH_OR3: usize = 25;
-
 /// Alternatives tried at the first level of a Lin–Kernighan move on tours of at least
 /// `LK_BREADTH_FROM` nodes without 3-opt steps (deeper levels, and every level on smaller
-/// tours, are greedy). Measured at 10 s on 2 cores, 6 seeds, with chains of 2-opt and 3-opt
-/// steps 6 deep: pcb3038 0.31 % → 0.25 % and fnl4461 0.37 % → 0.29 % above the optimum with 3
-/// alternatives; pr1002 did worse (0.25 % → 0.34 %). With 25-deep chains (`LK_DEPTH_OR3`) one
-/// alternative did better (seeds 1-3: 0.32 % against 0.23 % for the two instances summed).
+/// tours, are greedy). Measured at 10 s on 2 cores, 6 seeds, on TSPLIB tours with chains of
+/// 2-opt and 3-opt steps 6 deep: pcb3038 0.31 % → 0.25 % and fnl4461 0.37 % → 0.29 % above the
+/// optimum with 3 alternatives; pr1002 did worse (0.25 % → 0.34 %).
 const LK_BREADTH: usize = 3;
 const LK_BREADTH_FROM: usize = 2000;
 /// Above this size the first level stays greedy: on 100,000 random strokes (two modes each) the
@@ -55,41 +47,18 @@ const LK_BREADTH_UP_TO: usize = 20_000;
 /// where an array reversal of half the tour costs more than the rest of the step.
 const LK_TENTATIVE_HUGE: usize = 1000;
 
-/// One step of a Lin–Kernighan chain, changing the cost by `step`; `g2` is the partial gain
-/// after it. A 2-opt step reverses positions `lo..=hi` (adding t2–t3, removing t3–t4). A
-/// sequential 3-opt step (`t5 != NONE`) removes t3–t4 on the side that would split the tour,
-/// then t5–t6 inside the piece cut off, and adds t2–t3 and t4–t5 (see [`LocalSearch::or3_apply`]).
+/// One 2-opt step of a Lin–Kernighan chain: reverses positions `lo..=hi` (adding t2–t3,
+/// removing t3–t4, so that t4 is the chain's new end), changing the cost by `step`; `g2` is
+/// the partial gain after it.
 #[derive(Clone, Copy)]
 struct LkStep {
     lo: usize,
     hi: usize,
     step: Cost,
-    t2: u32,
     t3: u32,
     t4: u32,
-    t5: u32,
-    t6: u32,
     g2: Cost,
 }
-
-impl LkStep {
-    /// The node the chain goes on from (the new t2).
-    fn end(&self) -> u32 {
-        if self.t5 == NONE {
-            self.t4
-        } else {
-            self.t6
-        }
-    }
-}
-
-/// No node (a 2-opt step in [`LkStep`]).
-const NONE: u32 = u32::MAX;
-
-/// Candidates of t4 tried for t5 in a sequential 3-opt step. At 10 s on 2 cores, 3 seeds,
-/// 3 did better than 5 on fnl4461 (0.16 % against 0.20 % above the optimum by median) and
-/// pcb3038 (0.27 % against 0.38 %); pr1002 was mixed.
-const OR3_BREADTH: usize = 3;
 
 pub(crate) struct LocalSearch<'a, 'p, C> {
     net: &'a Net<'p, C>,
@@ -124,10 +93,12 @@ pub(crate) struct LocalSearch<'a, 'p, C> {
     /// Longest stretch a Lin–Kernighan step reverses tentatively (closings are priced whatever
     /// their length).
     lk_max_tentative: usize,
-    /// Lin–Kernighan steps may be sequential 3-opt moves (plain symmetric one-mode tours).
-    lk_or3: bool,
-    /// Deepest chain of a Lin–Kernighan move (`LK_DEPTH`, or `LK_DEPTH_OR3` with 3-opt steps).
-    lk_depth: usize,
+    /// Lin–Kernighan chains are made of sequential 3-opt moves (plain symmetric one-mode
+    /// tours, see [`uses_or3`] and `lk3`).
+    lk3: bool,
+    /// Arcs the current chain of 3-opt moves added and removed.
+    lk3_added: Vec<(u32, u32)>,
+    lk3_removed: Vec<(u32, u32)>,
 }
 
 /// Whether Or-opt and the segment exchange apply the positive-gain criterion: a move whose
@@ -184,8 +155,9 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             lk_max_tentative: if net.n > LK_BREADTH_UP_TO { LK_TENTATIVE_HUGE } else { usize::MAX },
             lk_alts: Vec::new(),
             lk_one: Vec::new(),
-            lk_or3: or3,
-            lk_depth: if or3 { LK_DEPTH_OR3 } else { LK_DEPTH },
+            lk3: or3,
+            lk3_added: Vec::new(),
+            lk3_removed: Vec::new(),
         }
     }
 
@@ -253,9 +225,9 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         }
         if tour.pos[v as usize] == 0 {
             // Position 0 never moves, but its arcs can still change through reversals.
-            return self.two_opt && self.try_lk(tour, v);
+            return self.two_opt && (if self.lk3 { self.try_lk3(tour, v) } else { self.try_lk(tour, v) });
         }
-        if self.two_opt && self.try_lk(tour, v) {
+        if self.two_opt && (if self.lk3 { self.try_lk3(tour, v) } else { self.try_lk(tour, v) }) {
             return true;
         }
         if self.try_or_opt(tour, v) {
@@ -819,11 +791,9 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
     /// stretch between, so the tour stays closed. At each level every candidate's closing is
     /// priced exactly without touching the tour (that level is plain 2-opt); if none improves, the
     /// step with the largest partial gain is applied tentatively and the chain goes on from t4
-    /// (depth up to `LK_DEPTH`); nothing improving means everything is undone. On plain
-    /// symmetric one-mode tours a step may also be a sequential 3-opt move (`or3_steps`), as
-    /// in LKH's basic moves: 19 TSPLIB instances of 200-2392 nodes at 5 s on 2 cores, gaps to
-    /// the optima summed 1.69 / 2.57 % (seeds 1 / 2) against 2.78 / 3.40 % without. On large tours
+    /// (depth up to `LK_DEPTH`); nothing improving means everything is undone. On large tours
     /// the first level backtracks: the chain is tried from each of its `lk_breadth` best steps.
+    /// (Plain symmetric one-mode tours use chains of 3-opt moves instead, see `lk3`.)
     fn try_lk(&mut self, tour: &mut Tour, t1: u32) -> bool {
         if tour.len() < 5 {
             return false;
@@ -843,14 +813,14 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             // best few steps in turn
             alts.clear();
             if let Some(c) = self.lk_level(tour, t1, t2, g, 0.0, 1, self.lk_breadth, &mut alts) {
-                self.lk_apply(tour, t1, &c);
+                self.lk_apply(tour, &c);
                 improved = true;
                 break 'dirs;
             }
             for a in 0..alts.len() {
                 let step = alts[a];
-                self.lk_apply(tour, t1, &step);
-                if self.lk_deeper(tour, t1, step.end(), step.g2, step.step) {
+                self.lk_apply(tour, &step);
+                if self.lk_deeper(tour, t1, step.t4, step.g2, step.step) {
                     improved = true;
                     break 'dirs;
                 }
@@ -883,20 +853,20 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
     fn lk_deeper(&mut self, tour: &mut Tour, t1: u32, mut t2: u32, mut g: Cost, mut so_far: Cost) -> bool {
         let mut one = std::mem::take(&mut self.lk_one);
         let mut improved = false;
-        for depth in 2..=self.lk_depth {
+        for depth in 2..=LK_DEPTH {
             one.clear();
             if let Some(c) = self.lk_level(tour, t1, t2, g, so_far, depth, 1, &mut one) {
-                self.lk_apply(tour, t1, &c);
+                self.lk_apply(tour, &c);
                 improved = true;
                 break;
             }
             let Some(&step) = one.first() else { break };
-            if depth == self.lk_depth {
+            if depth == LK_DEPTH {
                 break;
             }
-            self.lk_apply(tour, t1, &step);
+            self.lk_apply(tour, &step);
             so_far += step.step;
-            t2 = step.end();
+            t2 = step.t4;
             g = step.g2;
         }
         self.lk_one = one;
@@ -966,10 +936,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             } else {
                 so_far + self.reversal_delta(tour, lo, hi)
             };
-            if self.lk_or3 {
-                self.or3_steps(tour, t1, t2, t3, g1, so_far, forward, cap, &mut close, &mut close_total, deeper);
-            }
-            let step = LkStep { lo, hi, step: total - so_far, t2, t3, t4, t5: NONE, t6: NONE, g2 };
+            let step = LkStep { lo, hi, step: total - so_far, t3, t4, g2 };
             // keep the `cap` largest partial gains, best first (on huge tours only short
             // stretches are reversed tentatively)
             let len = hi - lo + 1;
@@ -992,92 +959,6 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         close
     }
 
-    /// Sequential 3-opt steps from t1–t2 (removed) and t2–t3 (added), on plain symmetric
-    /// tours: t4 is t3's neighbour on the far side, whose removal would cut the stretch t2..t3
-    /// off as a cycle; t5 is a candidate of t4 inside that stretch and t6 a neighbour of t5
-    /// there, so that adding t4–t5 and removing t5–t6 joins the pieces again (both neighbours
-    /// do: one gives a segment exchange, the other a double reversal). Lin and Kernighan's
-    /// original move; as in LKH (Helsgaun 2000), it is a basic step of the chain.
-    #[allow(clippy::too_many_arguments)]
-    fn or3_steps(
-        &self,
-        tour: &Tour,
-        t1: u32,
-        t2: u32,
-        t3: u32,
-        g1: Cost,
-        so_far: Cost,
-        forward: bool,
-        cap: usize,
-        close: &mut Option<LkStep>,
-        close_total: &mut Cost,
-        deeper: &mut Vec<LkStep>,
-    ) {
-        let net = self.net;
-        let succ = |x: u32| if forward { tour.next(x) } else { tour.prev(x) };
-        let pred = |x: u32| if forward { tour.prev(x) } else { tour.next(x) };
-        let t4 = succ(t3);
-        if t4 == t1 || t3 == succ(t2) {
-            return;
-        }
-        // positions along the traversal direction, measured from t2
-        let n = tour.len();
-        let p2 = tour.pos[t2 as usize] as usize;
-        let along = |x: u32| {
-            let px = tour.pos[x as usize] as usize;
-            if forward {
-                (px + n - p2) % n
-            } else {
-                (p2 + n - px) % n
-            }
-        };
-        let span = along(t3);
-        let g2 = g1 + net.arc(t3, 0, t4, 0);
-        // one mode and symmetric: the lists' lower bounds are the arcs' costs
-        for (&t5, &c45) in self.nb.out(t4).iter().zip(self.nb.out_lb(t4)).take(OR3_BREADTH) {
-            let g3 = g2 - c45;
-            if g3 <= self.eps {
-                break;
-            }
-            let a5 = along(t5);
-            if a5 > span || t5 == t3 {
-                continue; // t5 must lie in t2..t3, and t5 = t3 would add t3–t4 back
-            }
-            // t6 after t5 (segment exchange) or before it (double reversal), both inside t2..t3
-            for (t6, after) in [(succ(t5), true), (pred(t5), false)] {
-                if t6 == t1 || (after && a5 == span) {
-                    continue;
-                }
-                let g4 = g3 + net.arc(t5, 0, t6, 0);
-                let total = net.arc(t6, 0, t1, 0) - g4;
-                let step = LkStep { lo: 0, hi: 0, step: total - so_far, t2, t3, t4, t5, t6, g2: g4 };
-                if total < *close_total {
-                    *close_total = total;
-                    *close = Some(step);
-                }
-                if ranks(deeper, cap, g4) {
-                    offer(deeper, cap, step);
-                }
-            }
-        }
-    }
-
-    /// Applies a sequential 3-opt step as 2-opt moves (each a valid tour): for t6 after t5 the
-    /// stretches t2..t5 and t6..t3 trade places, for t6 before t5 both are reversed in place.
-    fn or3_apply(&self, tour: &mut Tour, t1: u32, s: &LkStep) {
-        let (t2, t3, t4, t5, t6) = (s.t2, s.t3, s.t4, s.t5, s.t6);
-        let forward = tour.next(t1) == t2;
-        let t6_after = if forward { tour.next(t5) == t6 } else { tour.prev(t5) == t6 };
-        if t6_after {
-            self.flip(tour, t1, t2, t3, t4);
-            self.flip(tour, t1, t3, t6, t5);
-            self.flip(tour, t3, t5, t2, t4);
-        } else {
-            self.flip(tour, t1, t2, t6, t5);
-            self.flip(tour, t2, t5, t3, t4);
-        }
-    }
-
     /// A 2-opt move: removes the arcs x1–y1 and x2–y2 (y1 following x1 and y2 following x2 in
     /// the same direction round the tour) and adds x1–x2 and y1–y2.
     fn flip(&self, tour: &mut Tour, x1: u32, y1: u32, x2: u32, y2: u32) {
@@ -1097,14 +978,8 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
     }
 
     /// Applies one step of a Lin–Kernighan chain started at `t1`.
-    fn lk_apply(&mut self, tour: &mut Tour, t1: u32, step: &LkStep) {
-        if step.t5 == NONE {
-            self.reverse_short_way(tour, step.lo, step.hi);
-        } else {
-            self.or3_apply(tour, t1, step);
-            self.touch(step.t5);
-            self.touch(step.t6);
-        }
+    fn lk_apply(&mut self, tour: &mut Tour, step: &LkStep) {
+        self.reverse_short_way(tour, step.lo, step.hi);
         tour.cost += step.step;
         self.touch(step.t3);
         self.touch(step.t4);
@@ -1177,82 +1052,4 @@ fn offer(deeper: &mut Vec<LkStep>, cap: usize, step: LkStep) {
     let at = deeper.iter().position(|d| step.g2 > d.g2).unwrap_or(deeper.len());
     deeper.insert(at, step);
     deeper.truncate(cap);
-}
-
-#[cfg(test)]
-mod tests {
-    use std::collections::BTreeSet;
-
-    use rand::{Rng, SeedableRng};
-    use rand_pcg::Pcg64Mcg;
-
-    use super::*;
-    use crate::search::testing::random_tour_problem;
-
-    fn key(a: u32, b: u32) -> (u32, u32) {
-        (a.min(b), a.max(b))
-    }
-
-    fn edges(tour: &Tour) -> BTreeSet<(u32, u32)> {
-        (0..tour.len()).map(|i| key(tour.seq[i], tour.next_of_pos(i))).collect()
-    }
-
-    /// Every sequential 3-opt step the chain can take gives the tour whose arcs are the old
-    /// ones less t1–t2, t3–t4, t5–t6 plus t2–t3, t4–t5, t6–t1, and the priced change is the
-    /// change of the recomputed cost: both traversal directions, both choices of t6, stretches
-    /// across position 0.
-    #[test]
-    fn sequential_three_opt_steps_make_the_priced_tour() {
-        let n = 40;
-        let mut rng = Pcg64Mcg::seed_from_u64(5);
-        let p = random_tour_problem(&mut rng, n, 100.0);
-        let net = Net::new(&p);
-        assert!(uses_or3(&net));
-        let nb = Neighbors::build(&net, 10);
-        let ls = LocalSearch::new(&net, &nb, 1e-9);
-        let mut checked = 0;
-        for trial in 0..400 {
-            let mut seq: Vec<u32> = (0..n as u32).collect();
-            for i in (1..n).rev() {
-                seq.swap(i, rng.gen_range(0..=i));
-            }
-            let mut tour = Tour::new(&net, seq, vec![0; n]);
-            let forward = trial % 2 == 0;
-            let succ = |t: &Tour, x: u32| if forward { t.next(x) } else { t.prev(x) };
-            let pred = |t: &Tour, x: u32| if forward { t.prev(x) } else { t.next(x) };
-            let t1 = tour.seq[rng.gen_range(0..n)];
-            let t2 = succ(&tour, t1);
-            // t3 beyond t2, t5 inside t2..t3, as `or3_steps` requires
-            let walk: Vec<u32> = std::iter::successors(Some(t2), |&x| Some(succ(&tour, x))).take(n - 1).collect();
-            let i3 = rng.gen_range(2..n - 2);
-            let t3 = walk[i3];
-            let t4 = succ(&tour, t3);
-            let i5 = rng.gen_range(0..i3);
-            let t5 = walk[i5];
-            let t6 = if rng.gen_bool(0.5) { succ(&tour, t5) } else { pred(&tour, t5) };
-            if t6 == t1 {
-                continue;
-            }
-            let c = |a: u32, b: u32| net.arc(a, 0, b, 0);
-            let delta = c(t2, t3) + c(t4, t5) + c(t6, t1) - c(t1, t2) - c(t3, t4) - c(t5, t6);
-            let mut want = edges(&tour);
-            for (a, b) in [(t1, t2), (t3, t4), (t5, t6)] {
-                assert!(want.remove(&key(a, b)));
-            }
-            for (a, b) in [(t2, t3), (t4, t5), (t6, t1)] {
-                want.insert(key(a, b));
-            }
-            let before = tour.full_cost(&net);
-            let step = LkStep { lo: 0, hi: 0, step: delta, t2, t3, t4, t5, t6, g2: 0.0 };
-            ls.or3_apply(&mut tour, t1, &step);
-            assert_eq!(edges(&tour), want, "trial {trial}");
-            assert_eq!(want.len(), n, "trial {trial}: not one cycle");
-            assert!((tour.full_cost(&net) - before - delta).abs() < 1e-6, "trial {trial}");
-            // one cycle: walking from t1 visits every node
-            let visited = std::iter::successors(Some(t1), |&x| Some(tour.next(x))).take(n).collect::<BTreeSet<_>>();
-            assert_eq!(visited.len(), n);
-            checked += 1;
-        }
-        assert!(checked > 300);
-    }
 }
