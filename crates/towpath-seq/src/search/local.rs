@@ -833,17 +833,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             tour.undo_to(start);
         }
         self.lk_alts = alts;
-        if improved {
-            let touched = std::mem::take(&mut self.lk_touched);
-            for &x in &touched {
-                self.push(x);
-            }
-            self.lk_touched = touched;
-        }
-        if own_journal {
-            tour.commit();
-        }
-        improved
+        self.end_chain(tour, improved, own_journal)
     }
 
     /// Greedy continuation of a Lin–Kernighan chain from level 2: t2 is now `t2`, the partial
@@ -983,6 +973,22 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         tour.cost += step.step;
         self.touch(step.t3);
         self.touch(step.t4);
+    }
+
+    /// Ends a Lin–Kernighan chain: an improvement queues the ends of every arc it changed, and
+    /// a journal the chain opened is closed. Returns `improved`.
+    fn end_chain(&mut self, tour: &mut Tour, improved: bool, own_journal: bool) -> bool {
+        if improved {
+            let touched = std::mem::take(&mut self.lk_touched);
+            for &x in &touched {
+                self.push(x);
+            }
+            self.lk_touched = touched;
+        }
+        if own_journal {
+            tour.commit();
+        }
+        improved
     }
 
     /// Notes a node as an endpoint of an arc the current chain changed.

@@ -106,17 +106,7 @@ impl<C: CostModel> LocalSearch<'_, '_, C> {
             }
             tour.undo_to(start);
         }
-        if improved {
-            let touched = std::mem::take(&mut self.lk_touched);
-            for &x in &touched {
-                self.push(x);
-            }
-            self.lk_touched = touched;
-        }
-        if own_journal {
-            tour.commit();
-        }
-        improved
+        self.end_chain(tour, improved, own_journal)
     }
 
     /// One level from the open arc t1–t2 with partial gain `g` (the cost of the arcs removed
