@@ -223,12 +223,13 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         if self.net.multi_mode && self.try_mode(tour, v) {
             return true;
         }
-        if tour.pos[v as usize] == 0 {
-            // Position 0 never moves, but its arcs can still change through reversals.
-            return self.two_opt && (if self.lk3 { self.try_lk3(tour, v) } else { self.try_lk(tour, v) });
-        }
-        if self.two_opt && (if self.lk3 { self.try_lk3(tour, v) } else { self.try_lk(tour, v) }) {
+        let chain = self.two_opt && if self.lk3 { self.try_lk3(tour, v) } else { self.try_lk(tour, v) };
+        if chain {
             return true;
+        }
+        // Position 0 never moves (its arcs change only through reversals).
+        if tour.pos[v as usize] == 0 {
+            return false;
         }
         if self.lk3 {
             // Or-opt and the segment exchange are sequential 3-opt moves the chains already try

@@ -25,7 +25,7 @@ const T5_BREADTH: usize = 5;
 const NONE: u32 = u32::MAX;
 
 /// How a level's 3-opt move reconnects the tour.
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy)]
 enum Kind {
     /// t4 on the 2-opt side of t3: two 2-opt moves in a row.
     Flips,
