@@ -5,6 +5,8 @@ use clap::{Parser, Subcommand};
 
 mod cmd;
 mod exit;
+mod files;
+mod out;
 
 /// towpath plans and sequences the tool paths of robotic and CNC manufacturing: automated fiber
 /// placement first, then spray forming and machining.

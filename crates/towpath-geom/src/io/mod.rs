@@ -55,16 +55,21 @@ pub fn read_path(path: &Path) -> Result<Soup, MeshError> {
     read_bytes(&bytes, format).map_err(|e| e.in_file(path))
 }
 
-/// Writes a mesh file, the format chosen by extension (STL is written binary, PLY ascii).
-pub fn write_path(path: &Path, soup: &Soup) -> Result<(), MeshError> {
-    let format = Format::from_path(path).ok_or_else(|| MeshError::UnknownFormat { path: path.to_path_buf() })?;
+/// A mesh in a given format, as bytes (STL binary, PLY ascii).
+pub fn write_bytes(soup: &Soup, format: Format) -> std::io::Result<Vec<u8>> {
     let mut out = Vec::new();
     match format {
         Format::Stl => write_stl(&mut out, soup),
         Format::Obj => write_obj(&mut out, soup),
         Format::Ply => write_ply(&mut out, soup),
-    }
-    .map_err(|source| MeshError::Io { path: path.to_path_buf(), source })?;
+    }?;
+    Ok(out)
+}
+
+/// Writes a mesh file, the format chosen by extension (STL is written binary, PLY ascii).
+pub fn write_path(path: &Path, soup: &Soup) -> Result<(), MeshError> {
+    let format = Format::from_path(path).ok_or_else(|| MeshError::UnknownFormat { path: path.to_path_buf() })?;
+    let out = write_bytes(soup, format).map_err(|source| MeshError::Io { path: path.to_path_buf(), source })?;
     std::fs::write(path, out).map_err(|source| MeshError::Io { path: path.to_path_buf(), source })
 }
 

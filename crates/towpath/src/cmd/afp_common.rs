@@ -7,6 +7,7 @@ use towpath_machine::Machine;
 use towpath_nc::{Dialect, Width};
 
 use crate::exit;
+use crate::files::Files;
 
 /// Machine, dialect and course width options.
 #[derive(clap::Args, Debug, Clone)]
@@ -27,6 +28,15 @@ pub struct MachineArgs {
 }
 
 impl MachineArgs {
+    /// Declares the machine and dialect files as inputs.
+    pub fn declare(&self, files: &mut Files) -> anyhow::Result<()> {
+        files.input("machine file", &self.machine)?;
+        if let Some(d) = &self.dialect {
+            files.input("dialect file", d)?;
+        }
+        Ok(())
+    }
+
     /// Loads the machine and dialect files and checks the width.
     pub fn load(&self) -> anyhow::Result<(Machine, Dialect, Option<Width>)> {
         let machine = load_machine(&self.machine)?;
@@ -85,61 +95,4 @@ pub fn read(path: &Path) -> anyhow::Result<String> {
 pub fn load_machine(path: &Path) -> anyhow::Result<Machine> {
     let text = read(path)?;
     Machine::from_toml_str(&text).map_err(|e| exit::bad_input(anyhow::anyhow!("{}: {e}", path.display())))
-}
-
-/// Writes a file, creating its directory if need be, naming it on failure (a path that cannot
-/// be written is refused like a bad argument: exit code 2).
-pub fn write(path: &Path, text: &str) -> anyhow::Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create the directory", dir.display()))
-            .map_err(exit::bad_input)?;
-    }
-    std::fs::write(path, text).with_context(|| format!("{}: cannot write", path.display())).map_err(exit::bad_input)
-}
-
-/// Refuses outputs that would overwrite an input (or each other) before anything is written:
-/// the same path, however spelt, a symbolic link to it, or a hard link.
-pub fn guard_outputs(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> anyhow::Result<()> {
-    for (i, (what, out)) in outputs.iter().enumerate() {
-        if let Some((input, _)) = inputs.iter().find(|(_, p)| same_file(p, out)) {
-            return Err(exit::bad_input(anyhow::anyhow!(
-                "{}: the {what} would overwrite the {input}; give another path",
-                out.display()
-            )));
-        }
-        if let Some((other, _)) = outputs[..i].iter().find(|(_, p)| same_file(p, out)) {
-            return Err(exit::bad_input(anyhow::anyhow!(
-                "{}: the {what} and the {other} would be the same file; give another path",
-                out.display()
-            )));
-        }
-    }
-    Ok(())
-}
-
-/// True if two paths name the same file: the same inode when both exist, else the same
-/// directory (symbolic links resolved) and file name.
-fn same_file(a: &Path, b: &Path) -> bool {
-    if let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) {
-        #[cfg(unix)]
-        {
-            use std::os::unix::fs::MetadataExt;
-            return x.dev() == y.dev() && x.ino() == y.ino();
-        }
-        #[cfg(not(unix))]
-        {
-            let _ = (x, y);
-            return std::fs::canonicalize(a).ok() == std::fs::canonicalize(b).ok();
-        }
-    }
-    let resolved = |p: &Path| -> Option<PathBuf> {
-        let name = p.file_name()?;
-        let dir = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        Some(std::fs::canonicalize(dir).ok()?.join(name))
-    };
-    match (resolved(a), resolved(b)) {
-        (Some(x), Some(y)) => x == y,
-        _ => false,
-    }
 }

@@ -2,13 +2,12 @@
 //! GTSP-LIB, PCGLNS, towpath JSON) as towpath's JSON problem format, so that other programs
 //! (the peers of the benchmarks, a user's scripts) read exactly the problem towpath solves.
 
-use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{anyhow, Context};
 use towpath_formats::{read_instance, write_json, CostsAs};
 
-use crate::exit;
+use crate::files::Files;
+use crate::{exit, outln};
 
 /// Output formats of `towpath convert`.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,13 +45,10 @@ pub struct Args {
 
 /// Runs `towpath convert`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    let mut files = Files::new();
+    files.input("input", &args.file)?;
     if let Some(out) = &args.output {
-        if same_file(&args.file, out) {
-            return Err(exit::bad_input(anyhow!(
-                "{}: the output would overwrite the input; give another -o",
-                out.display()
-            )));
-        }
+        files.output("output", out)?;
     }
     let instance = read_instance(&args.file).map_err(exit::bad_input)?;
     let costs = if args.matrix { CostsAs::Matrix } else { CostsAs::Native };
@@ -60,22 +56,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Target::Json => write_json(&instance.to_json(costs)),
     };
     match &args.output {
-        Some(out) => std::fs::write(out, text + "\n").with_context(|| format!("{}: cannot write", out.display())),
-        None => {
-            let mut stdout = std::io::stdout().lock();
-            match writeln!(stdout, "{text}").and_then(|()| stdout.flush()) {
-                // A closed pipe (`towpath convert ... | head`) is not an error of ours.
-                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-                other => Ok(other?),
-            }
+        Some(out) => {
+            files.write(out, text + "\n")?;
+            files.commit()
         }
-    }
-}
-
-/// True if both paths name the same existing file.
-fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
-    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => false,
+        None => {
+            outln!("{text}");
+            Ok(())
+        }
     }
 }

@@ -18,7 +18,8 @@ use towpath_layup::output::{self, Meta, Post};
 use towpath_layup::ply::{self, Method, PlySpec};
 use towpath_layup::section::Coverage;
 
-use crate::exit;
+use crate::files::Files;
+use crate::{exit, outln};
 
 /// Arguments of `towpath layup`.
 #[derive(clap::Args, Debug)]
@@ -165,6 +166,7 @@ fn read_text(path: &Path) -> anyhow::Result<String> {
 /// Runs `towpath layup`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
+    let mut files = declare_files(&args)?;
     if !(args.tow_width > 0.0 && args.tow_width.is_finite()) {
         return Err(exit::bad_input(anyhow!("--tow-width must be a positive number of mm, got {}", args.tow_width)));
     }
@@ -187,7 +189,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let load_seconds = tl.elapsed().as_secs_f64();
     let mesh = &loaded.mesh;
     if let Some(path) = &args.write_mesh {
-        io::write_path(path, &mesh.to_soup()).map_err(exit::bad_input)?;
+        let format = mesh_format(path)?;
+        files.write(path, io::write_bytes(&mesh.to_soup(), format)?)?;
     }
     let angle = args.angle.to_radians();
     let width = args.tow_width * args.tows as f64;
@@ -255,14 +258,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let doc = output::to_json(&ply, &meta);
     let mut text = serde_json::to_string(&doc)?;
     text.push('\n');
-    std::fs::write(&args.output, text).with_context(|| format!("{}: cannot write", args.output.display()))?;
+    files.write(&args.output, text)?;
     if let Some(path) = &args.gcode {
-        std::fs::write(path, output::to_gcode(&ply, &meta, &Post::default()))
-            .with_context(|| format!("{}: cannot write", path.display()))?;
+        files.write(path, output::to_gcode(&ply, &meta, &Post::default()))?;
     }
     if let Some(path) = &args.csv {
-        std::fs::write(path, output::to_csv(&ply)).with_context(|| format!("{}: cannot write", path.display()))?;
+        files.write(path, output::to_csv(&ply))?;
     }
+    files.commit()?;
     let q = &ply.quality;
     if args.json {
         let mut s = output::summary(&ply);
@@ -273,23 +276,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             o.insert("total_seconds".into(), t0.elapsed().as_secs_f64().into());
             o.insert("output".into(), args.output.display().to_string().into());
         }
-        println!("{s}");
+        outln!("{s}");
     } else {
         let r = &loaded.report;
-        println!(
-            "towpath layup: {} ({} triangles, {} vertices)",
-            args.surface,
-            mesh.num_faces(),
-            mesh.positions().len()
-        );
+        outln!("towpath layup: {} ({} triangles, {} vertices)", args.surface, mesh.num_faces(), mesh.positions().len());
         if r.degenerate_removed + r.duplicates_removed + r.flipped + r.non_manifold_edges + r.orientation_conflicts > 0
         {
-            println!(
+            outln!(
                 "  repairs         : {} degenerate and {} duplicate triangles removed, {} flipped, {} non-manifold and {} non-orientable edges cut",
                 r.degenerate_removed, r.duplicates_removed, r.flipped, r.non_manifold_edges, r.orientation_conflicts
             );
         }
-        println!(
+        outln!(
             "  ply             : {} ({}), {} x {} mm tows, coverage {} %",
             meta.angle_deg,
             meta.direction_source,
@@ -297,7 +295,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             args.tow_width,
             coverage.percent()
         );
-        println!(
+        outln!(
             "  courses         : {} (N1 = {} left, N2 = {} right; section estimate {} / {})",
             ply.courses.len(),
             ply.n1,
@@ -305,25 +303,68 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             ply.n_estimate[0],
             ply.n_estimate[1]
         );
-        println!("  coverage        : {:.2} % of {:.0} mm2", q.coverage_percent, q.ply_area);
-        println!(
+        outln!("  coverage        : {:.2} % of {:.0} mm2", q.coverage_percent, q.ply_area);
+        outln!(
             "  gaps / overlaps : {:.0} / {:.0} mm2 (widest {:.2} / {:.2} mm)",
-            q.gap_area, q.overlap_area, q.max_gap, q.max_overlap
+            q.gap_area,
+            q.overlap_area,
+            q.max_gap,
+            q.max_overlap
         );
-        println!(
+        outln!(
             "  steering        : min radius {} (limit {:.0} mm, {} points below)",
             q.min_steering_radius.map_or("straight".to_string(), |r| format!("{r:.0} mm")),
             q.min_steering_radius_limit,
             q.points_below_min_radius
         );
-        println!(
+        outln!(
             "  angle deviation : mean {:.3} deg, max {:.3} deg",
-            q.mean_angle_deviation_deg, q.max_angle_deviation_deg
+            q.mean_angle_deviation_deg,
+            q.max_angle_deviation_deg
         );
-        println!("  time            : {:.3} s planning, {:.3} s total", ply.seconds, t0.elapsed().as_secs_f64());
-        println!("  wrote           : {}", args.output.display());
+        outln!("  time            : {:.3} s planning, {:.3} s total", ply.seconds, t0.elapsed().as_secs_f64());
+        outln!("  wrote           : {}", args.output.display());
     }
     Ok(())
+}
+
+/// The run's inputs (surface, NURBS patch, curves, samples) and outputs, checked against each
+/// other before any work.
+fn declare_files(args: &Args) -> anyhow::Result<Files> {
+    let mut files = Files::new();
+    match args.surface.split_once(':') {
+        Some(("nurbs", path)) => files.input("NURBS patch", Path::new(path))?,
+        Some(("plane" | "cylinder" | "cone" | "sphere", _)) => {}
+        _ => files.input("mesh", Path::new(&args.surface))?,
+    }
+    for g in &args.guide {
+        files.input("guide curve", g)?;
+    }
+    if let Some(p) = &args.orientations {
+        files.input("orientation samples", p)?;
+    }
+    if let Some(p) = &args.boundary {
+        files.input("boundary curve", p)?;
+    }
+    files.output("courses file (-o)", &args.output)?;
+    if let Some(p) = &args.gcode {
+        files.output("G-code program", p)?;
+    }
+    if let Some(p) = &args.csv {
+        files.output("CSV table", p)?;
+    }
+    if let Some(p) = &args.write_mesh {
+        mesh_format(p)?;
+        files.output("written mesh", p)?;
+    }
+    Ok(files)
+}
+
+/// The mesh format `--write-mesh` names by its extension.
+fn mesh_format(path: &Path) -> anyhow::Result<io::Format> {
+    io::Format::from_path(path).ok_or_else(|| {
+        exit::bad_input(anyhow!("{}: --write-mesh needs a .stl, .obj or .ply file name", path.display()))
+    })
 }
 
 fn progress_bar() -> indicatif::ProgressBar {

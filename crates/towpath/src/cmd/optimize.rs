@@ -6,9 +6,10 @@ use std::time::Duration;
 use towpath_machine::CostKind;
 use towpath_nc::{optimize, AfpOptions, NcError, OptimizeOptions, PrecedenceRule, Report};
 
-use super::afp_common::{guard_outputs, read, write, MachineArgs};
+use super::afp_common::{read, MachineArgs};
 use super::solver_args::SolverArgs;
-use crate::exit;
+use crate::files::Files;
+use crate::{exit, outln};
 
 /// Arguments of `towpath optimize`.
 #[derive(clap::Args, Debug)]
@@ -35,6 +36,10 @@ pub struct Args {
     /// Solver time limit in seconds (default: 1 s plus 0.2 ms per course, at most 10 s).
     #[arg(long, value_name = "S")]
     pub time_limit: Option<f64>,
+    /// Work budget: improvement kicks summed over threads. Without --time-limit there is then no
+    /// time limit, and the output depends only on the inputs, --seed and --threads.
+    #[arg(long, value_name = "N")]
+    pub iterations: Option<u64>,
     /// Solver seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -67,15 +72,13 @@ pub fn classify(file: &std::path::Path, e: NcError) -> anyhow::Error {
 /// Runs `towpath optimize`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let given_limit = args.time_limit.map(super::solver_args::time_limit).transpose()?;
-    let mut inputs = vec![("program", args.program.as_path()), ("machine file", args.machine.machine.as_path())];
-    if let Some(d) = &args.machine.dialect {
-        inputs.push(("dialect file", d.as_path()));
-    }
-    let mut outputs = vec![("output", args.output.as_path())];
+    let mut files = Files::new();
+    args.machine.declare(&mut files)?;
+    files.input("program", &args.program)?;
+    files.output("output", &args.output)?;
     if let Some(r) = &args.report {
-        outputs.push(("report", r.as_path()));
+        files.output("report", r)?;
     }
-    guard_outputs(&inputs, &outputs)?;
     let (machine, dialect, width) = args.machine.load()?;
     let text = read(&args.program)?;
     let afp = AfpOptions {
@@ -86,17 +89,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         width,
     };
     // The course count decides the default time limit; count roller contacts cheaply.
-    let time_limit = match given_limit {
-        Some(t) => t,
-        None => {
+    let time_limit = match (given_limit, args.iterations) {
+        (Some(t), _) => Some(t),
+        (None, Some(_)) => None,
+        (None, None) => Some({
             let courses = text.lines().filter(|l| l.contains(dialect.contact_on.as_str())).count().max(1);
             towpath_nc::auto_time_limit(if dialect.contact_on.is_empty() { 1000 } else { courses })
-        }
+        }),
     };
     let bar = progress_bar(time_limit);
     let opts = OptimizeOptions {
         afp: afp.clone(),
-        time_limit: Some(time_limit),
+        time_limit,
+        iterations: args.iterations,
         seed: args.seed,
         threads: args.threads.unwrap_or_else(|| OptimizeOptions::default().threads),
         progress: bar.clone().map(|b| {
@@ -108,14 +113,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }),
         solver: args.solver.solver,
         baselines: args.solver.params(),
-        ..OptimizeOptions::default()
     };
     let o = optimize(&text, &machine, &dialect, &opts).map_err(|e| classify(&args.program, e));
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
     let o = o?;
-    write(&args.output, &o.text)?;
+    files.write(&args.output, &o.text)?;
     let name =
         args.program.file_name().map_or_else(|| args.program.display().to_string(), |n| n.to_string_lossy().into());
     let report = Report::new(&name, &machine, &o, &afp);
@@ -127,20 +131,22 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         } else {
             serde_json::to_string_pretty(&report)?
         };
-        write(path, &body)?;
+        files.write(path, &body)?;
     }
+    files.commit()?;
     if args.json {
-        println!("{}", serde_json::to_string(&report)?);
+        outln!("{}", serde_json::to_string(&report)?);
     } else {
-        print!("{}", report.summary());
-        println!("  written to {}", args.output.display());
+        crate::out!("{}", report.summary());
+        outln!("  written to {}", args.output.display());
     }
     Ok(())
 }
 
 /// A progress bar on stderr, only when it is a terminal.
-fn progress_bar(limit: Duration) -> Option<indicatif::ProgressBar> {
+fn progress_bar(limit: Option<Duration>) -> Option<indicatif::ProgressBar> {
     use std::io::IsTerminal;
+    let limit = limit?;
     if !std::io::stderr().is_terminal() {
         return None;
     }

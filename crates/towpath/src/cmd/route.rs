@@ -12,7 +12,8 @@ use towpath_coverage::{read_instance, seed004_like, verify_route, write_instance
 use towpath_seq::SolveOptions;
 
 use crate::cmd::solver_args::{refused, SolverArgs};
-use crate::exit;
+use crate::files::Files;
+use crate::{exit, outln};
 
 /// Arguments of `towpath route`.
 #[derive(clap::Args, Debug)]
@@ -61,9 +62,19 @@ pub struct Args {
 
 /// Runs `towpath route`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    let mut files = Files::new();
+    if let Some(g) = &args.graph {
+        files.input("graph", g)?;
+    }
+    if let Some(path) = &args.output {
+        files.output("route", path)?;
+    }
+    if let Some(path) = &args.save_instance {
+        files.output("saved instance", path)?;
+    }
     let instance = load(&args)?;
     if let Some(path) = &args.save_instance {
-        std::fs::write(path, write_instance(&instance)).with_context(|| format!("writing {}", path.display()))?;
+        files.write(path, write_instance(&instance))?;
     }
     let model = RppModel::new(instance).map_err(exit::bad_input)?;
     let mut opts = SolveOptions {
@@ -101,27 +112,28 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let out = RouteJson::new(model.instance(), &route, name.as_str(), report.elapsed.as_secs_f64());
     if let Some(path) = &args.output {
         let text = serde_json::to_string_pretty(&out)?;
-        std::fs::write(path, text + "\n").with_context(|| format!("writing {}", path.display()))?;
+        files.write(path, text + "\n")?;
     }
+    files.commit()?;
     if args.json {
-        println!("{}", serde_json::to_string(&out)?);
+        outln!("{}", serde_json::to_string(&out)?);
     } else {
         let i = model.instance();
-        println!("towpath route: {}", i.name().unwrap_or("(unnamed)"));
-        println!(
+        outln!("towpath route: {}", i.name().unwrap_or("(unnamed)"));
+        outln!(
             "  graph              : {} vertices, {} edges, {} required",
             i.vertices().len(),
             i.edges().len(),
             i.required().len()
         );
-        println!("  solver             : {name} — {}", name.reference());
-        println!("  path length        : {length:>12.3}");
-        println!("  required edges     : {:>12.3}", out.required_length);
-        println!("  connecting travel  : {:>12.3}", out.deadhead_length);
-        println!("  vertices on walk   : {:>12}", route.vertices.len());
-        println!("  solver time        : {:>12.3} s", report.elapsed.as_secs_f64());
+        outln!("  solver             : {name} — {}", name.reference());
+        outln!("  path length        : {length:>12.3}");
+        outln!("  required edges     : {:>12.3}", out.required_length);
+        outln!("  connecting travel  : {:>12.3}", out.deadhead_length);
+        outln!("  vertices on walk   : {:>12}", route.vertices.len());
+        outln!("  solver time        : {:>12.3} s", report.elapsed.as_secs_f64());
         if let Some(path) = &args.output {
-            println!("  route written to   : {}", path.display());
+            outln!("  route written to   : {}", path.display());
         }
     }
     Ok(())

@@ -1,7 +1,7 @@
 //! `towpath solve FILE`: reads a problem (TSPLIB TSP/ATSP/SOP, GTSP-LIB, PCGLNS or towpath
 //! JSON), solves it, checks the answer independently and prints it in the file's numbering.
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
@@ -12,7 +12,7 @@ use towpath_formats::{read_instance, with_problem, Instance};
 use towpath_seq::{Progress, SolveOptions, SolveReport};
 
 use crate::cmd::solver_args::{refusal, SolverArgs};
-use crate::exit;
+use crate::{exit, outln};
 
 /// Arguments of `towpath solve`.
 #[derive(clap::Args, Debug)]
@@ -89,11 +89,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let cost = instance.problem.check(&report.solution.steps).map_err(|v| {
         exit::check_failed(anyhow!("{}: the solver's answer does not verify: {v}", args.file.display()))
     })?;
-    match print_answer(&args, &instance, &report, cost, threads) {
-        // A closed pipe (`towpath solve ... | head -1`) is not an error of ours.
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        other => Ok(other?),
-    }
+    print_answer(&args, &instance, &report, cost, threads);
+    Ok(())
 }
 
 /// A progress bar on stderr, only when stderr is a terminal.
@@ -108,18 +105,10 @@ fn progress_bar(bounded: bool) -> Option<indicatif::ProgressBar> {
     Some(bar)
 }
 
-fn print_answer(
-    args: &Args,
-    instance: &Instance,
-    report: &SolveReport,
-    cost: f64,
-    threads: usize,
-) -> std::io::Result<()> {
-    let mut out = std::io::stdout().lock();
+fn print_answer(args: &Args, instance: &Instance, report: &SolveReport, cost: f64, threads: usize) {
     let tour = instance.answer(&report.solution.steps);
     if args.json {
-        writeln!(
-            out,
+        outln!(
             "{}",
             serde_json::json!({
                 "file": args.file.display().to_string(),
@@ -136,11 +125,10 @@ fn print_answer(
                 "seed": args.seed,
                 "threads": threads,
             })
-        )?;
-        return out.flush();
+        );
+        return;
     }
-    writeln!(
-        out,
+    outln!(
         "{} ({}, dimension {}, {} tasks): cost {} in {:.2} s, {} iterations{} (solver {}, seed {}, {} threads); checked",
         instance.name,
         instance.kind,
@@ -153,14 +141,13 @@ fn print_answer(
         args.solver.solver,
         args.seed,
         threads
-    )?;
+    );
     const SHOWN: usize = 40;
     let text = tour.to_string();
     if tour.len() <= SHOWN {
-        writeln!(out, "tour: {text}")?;
+        outln!("tour: {text}");
     } else {
         let head: Vec<&str> = text.split(' ').take(SHOWN).collect();
-        writeln!(out, "tour: {} … ({} steps; --json prints all)", head.join(" "), tour.len())?;
+        outln!("tour: {} … ({} steps; --json prints all)", head.join(" "), tour.len());
     }
-    out.flush()
 }

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use towpath_nc::{totals, verify, PrecedenceRule, VerifyError, VerifyOptions};
 
 use super::afp_common::{read, MachineArgs};
-use crate::exit;
+use crate::{exit, outln};
 
 /// Arguments of `towpath verify`.
 #[derive(clap::Args, Debug)]
@@ -56,7 +56,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     })?;
     let t = totals(&v);
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::json!({
                 "verified": true,
@@ -68,7 +68,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
         return Ok(());
     }
-    println!(
+    outln!(
         "verified: {} courses, same motion on-part ({} laid in reverse), precedence {}",
         v.courses,
         v.reversed,
@@ -79,12 +79,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             (true, ..) => "kept",
         }
     );
-    println!(
+    outln!(
         "  {:<6} {:>14} {:>14} {:>8} {:>14} {:>14} {:>8}",
-        "cost", "off-part in", "off-part out", "saved", "total in", "total out", "saved"
+        "cost",
+        "off-part in",
+        "off-part out",
+        "saved",
+        "total in",
+        "total out",
+        "saved"
     );
     for x in &t {
-        println!(
+        outln!(
             "  {:<6} {:>14.1} {:>14.1} {:>7.1}% {:>14.1} {:>14.1} {:>7.1}%   ({})",
             x.kind.name(),
             x.off_before,

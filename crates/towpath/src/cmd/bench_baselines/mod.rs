@@ -71,13 +71,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         machine()
     ));
     let section = rpp::run(&args)?;
-    print!("{section}");
+    crate::out!("{section}");
     md.push_str(&section);
     let section = afp_like::run(&args)?;
-    print!("{section}");
+    crate::out!("{section}");
     md.push_str(&section);
     let section = gtsp::run(&args)?;
-    print!("{section}");
+    crate::out!("{section}");
     md.push_str(&section);
     if let Some(path) = &args.write {
         let old = std::fs::read_to_string(path).unwrap_or_default();

@@ -1,28 +1,12 @@
 //! `towpath layup` end to end: analytic and mesh surfaces, every direction source, outputs, and
 //! errors that name the input and the problem.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn towpath(dir: &Path, args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_towpath")).current_dir(dir).args(args).output().expect("run towpath")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("towpath-layup-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn json_of(out: &std::process::Output) -> serde_json::Value {
-    assert!(out.status.success(), "stderr: {}", String::from_utf8_lossy(&out.stderr));
-    serde_json::from_slice(&out.stdout).expect("one JSON object")
-}
+use super::common::*;
 
 #[test]
 fn cylinder_helix_ply_with_gcode_and_csv() {
-    let d = tmp("cyl");
-    let out = towpath(
+    let d = scratch("cyl");
+    let out = towpath_in(
         &d,
         &[
             "layup",
@@ -63,9 +47,9 @@ fn cylinder_helix_ply_with_gcode_and_csv() {
 
 #[test]
 fn mesh_file_with_guides_boundary_and_orientation_samples() {
-    let d = tmp("mesh");
+    let d = scratch("mesh");
     // A shallow cylindrical panel written as a mesh first.
-    let out = towpath(
+    let out = towpath_in(
         &d,
         &[
             "layup",
@@ -98,7 +82,7 @@ fn mesh_file_with_guides_boundary_and_orientation_samples() {
         })
         .collect();
     std::fs::write(d.join("ply.csv"), boundary).unwrap();
-    let out = towpath(
+    let out = towpath_in(
         &d,
         &[
             "layup",
@@ -139,7 +123,7 @@ fn mesh_file_with_guides_boundary_and_orientation_samples() {
         }
     }
     std::fs::write(d.join("field.csv"), samples).unwrap();
-    let out = towpath(
+    let out = towpath_in(
         &d,
         &[
             "layup",
@@ -168,9 +152,9 @@ fn mesh_file_with_guides_boundary_and_orientation_samples() {
 
 #[test]
 fn errors_name_the_input_and_the_problem() {
-    let d = tmp("err");
+    let d = scratch("err");
     let run = |args: &[&str]| {
-        let out = towpath(&d, args);
+        let out = towpath_in(&d, args);
         (out.status.code(), String::from_utf8_lossy(&out.stderr).to_string())
     };
     let base = ["--angle", "0", "--tow-width", "6.35", "--tows", "8", "-o", "x.json"];
@@ -212,7 +196,7 @@ fn errors_name_the_input_and_the_problem() {
 
 #[test]
 fn nurbs_patch_surface_is_tessellated_and_covered() {
-    let d = tmp("nurbs");
+    let d = scratch("nurbs");
     // A 400 × 300 mm bilinear-in-x, quadratic-in-y patch (a shallow trough).
     let patch = serde_json::json!({
         "degree_u": 1, "degree_v": 2,
@@ -221,7 +205,7 @@ fn nurbs_patch_surface_is_tessellated_and_covered() {
         "control": [[0, 0, 40], [0, 150, -40], [0, 300, 40], [400, 0, 40], [400, 150, -40], [400, 300, 40]]
     });
     std::fs::write(d.join("patch.json"), patch.to_string()).unwrap();
-    let out = towpath(
+    let out = towpath_in(
         &d,
         &[
             "layup",
@@ -247,8 +231,10 @@ fn nurbs_patch_surface_is_tessellated_and_covered() {
     assert!((6..=8).contains(&n), "{s}");
     assert!(s["coverage_percent"].as_f64().unwrap() > 99.0, "{s}");
     std::fs::write(d.join("bad.json"), r#"{"degree_u": 1}"#).unwrap();
-    let out =
-        towpath(&d, &["layup", "nurbs:bad.json", "--angle", "0", "--tow-width", "6.35", "--tows", "8", "-o", "b.json"]);
+    let out = towpath_in(
+        &d,
+        &["layup", "nurbs:bad.json", "--angle", "0", "--tow-width", "6.35", "--tows", "8", "-o", "b.json"],
+    );
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("bad.json"));
 }
@@ -303,10 +289,10 @@ fn moves_follow_the_head_frame(text: &str, machine: &towpath_machine::Machine) -
 
 #[test]
 fn layup_gcode_is_optimized_bidirectionally_and_verified() {
-    let d = tmp("gcode");
+    let d = scratch("gcode");
     std::fs::write(d.join("six-axis.toml"), SIX_AXIS).unwrap();
     let machine = towpath_machine::Machine::from_toml_str(SIX_AXIS).unwrap();
-    let out = towpath(
+    let out = towpath_in(
         &d,
         &[
             "layup",
@@ -338,7 +324,7 @@ fn layup_gcode_is_optimized_bidirectionally_and_verified() {
     let common = ["--machine", "six-axis.toml", "--tow-width", "6.35"];
     let mut args = vec!["optimize", "ply.nc", "--bidirectional", "--time-limit", "1", "-o", "opt.nc", "--json"];
     args.extend(common);
-    let r = json_of(&towpath(&d, &args));
+    let r = json_of(&towpath_in(&d, &args));
     assert_eq!(r["courses"].as_u64(), Some(courses), "{r}");
     assert!(r["reversed"].as_u64().unwrap() > 0, "a ply laid all one way has courses to reverse: {r}");
     // The optimized program lays the same courses, some reversed (heading C ± 180°): the head
@@ -347,7 +333,7 @@ fn layup_gcode_is_optimized_bidirectionally_and_verified() {
     assert!(moves_follow_the_head_frame(&optimized, &machine) > 100);
     let mut args = vec!["verify", "ply.nc", "opt.nc", "--json"];
     args.extend(common);
-    let v = json_of(&towpath(&d, &args));
+    let v = json_of(&towpath_in(&d, &args));
     assert_eq!(v["verified"], true, "{v}");
     assert_eq!(v["courses"].as_u64(), Some(courses));
 }

@@ -1,22 +1,13 @@
 //! `towpath solve` end to end: the built binary on committed fixtures.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../towpath-formats/tests/data").join(name)
-}
-
-fn towpath(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_towpath")).args(args).output().expect("the binary runs")
-}
+use super::common::*;
 
 /// Runs `towpath solve FILE --json` with a deterministic budget and parses the answer.
 fn solve_json(file: &str, extra: &[&str]) -> serde_json::Value {
-    let path = fixture(file);
+    let path = data(file);
     let mut args = vec!["solve", path.to_str().unwrap(), "--json", "--threads", "1", "--seed", "1"];
     args.extend_from_slice(extra);
-    let out = towpath(&args);
+    let out = towpath_out(&args);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{file}: {stderr}");
     serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{file}: not JSON ({e})"))
@@ -59,8 +50,8 @@ fn json_problem_answer_names_tasks_and_modes() {
 
 #[test]
 fn summary_says_checked() {
-    let path = fixture("br17.atsp");
-    let out = towpath(&["solve", path.to_str().unwrap(), "--iterations", "1000", "--threads", "1"]);
+    let path = data("br17.atsp");
+    let out = towpath_out(&["solve", path.to_str().unwrap(), "--iterations", "1000", "--threads", "1"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success());
     assert!(stdout.starts_with("br17 (ATSP, dimension 17, 17 tasks): cost 39 "), "{stdout}");
@@ -77,13 +68,13 @@ fn malformed_file_exits_2_with_file_and_line() {
         "NAME: bad\nTYPE: TSP\nDIMENSION: 3\nEDGE_WEIGHT_TYPE: EUC_2D\nNODE_COORD_SECTION\n1 0 0\n2 5\n3 1 1\nEOF\n",
     )
     .unwrap();
-    let out = towpath(&["solve", bad.to_str().unwrap(), "--json"]);
+    let out = towpath_out(&["solve", bad.to_str().unwrap(), "--json"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("bad.tsp:7: expected 2 coordinates for node 2, found 1"), "{stderr}");
     assert!(out.stdout.is_empty());
     let missing = dir.join("missing.tsp");
-    let out = towpath(&["solve", missing.to_str().unwrap()]);
+    let out = towpath_out(&["solve", missing.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -91,7 +82,7 @@ fn malformed_file_exits_2_with_file_and_line() {
 /// The cost of a closed tour over br17's full matrix, read from the file here (independent of
 /// the readers and the checker).
 fn br17_tour_cost(tour: &[u64]) -> f64 {
-    let text = std::fs::read_to_string(fixture("br17.atsp")).unwrap();
+    let text = std::fs::read_to_string(data("br17.atsp")).unwrap();
     let body = text.split("EDGE_WEIGHT_SECTION").nth(1).unwrap();
     let m: Vec<f64> = body.split_whitespace().filter_map(|w| w.parse().ok()).collect();
     assert!(m.len() >= 17 * 17);
@@ -123,9 +114,9 @@ fn every_solver_answers_and_says_which_ran() {
 #[test]
 fn randomized_solvers_repeat_under_a_seed() {
     for solver in ["ga", "aco1", "aco2"] {
-        let path = fixture("11berlin52.gtsp");
+        let path = data("11berlin52.gtsp");
         let run = |seed: &str| {
-            let out = towpath(&["solve", path.to_str().unwrap(), "--json", "--solver", solver, "--seed", seed]);
+            let out = towpath_out(&["solve", path.to_str().unwrap(), "--json", "--solver", solver, "--seed", seed]);
             assert!(out.status.success(), "{solver}: {}", String::from_utf8_lossy(&out.stderr));
             let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
             (v["tour"].clone(), v["cost"].as_f64().unwrap())
@@ -139,8 +130,8 @@ fn randomized_solvers_repeat_under_a_seed() {
 #[test]
 fn a_solver_that_cannot_take_the_problem_exits_2() {
     // Seed 000's solver has no consecutive groups; example.json has one.
-    let path = fixture("example.json");
-    let out = towpath(&["solve", path.to_str().unwrap(), "--solver", "doherty", "--json"]);
+    let path = data("example.json");
+    let out = towpath_out(&["solve", path.to_str().unwrap(), "--solver", "doherty", "--json"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(
@@ -159,11 +150,11 @@ fn a_solver_that_cannot_take_the_problem_exits_2() {
     }
     text.push_str("EOF\n");
     std::fs::write(&big, text).unwrap();
-    let out = towpath(&["solve", big.to_str().unwrap(), "--solver", "aco1"]);
+    let out = towpath_out(&["solve", big.to_str().unwrap(), "--solver", "aco1"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("grid2500.tsp") && stderr.contains("aco1") && stderr.contains("too large"), "{stderr}");
-    let out = towpath(&["solve", big.to_str().unwrap(), "--solver", "lkh"]);
+    let out = towpath_out(&["solve", big.to_str().unwrap(), "--solver", "lkh"]);
     assert_eq!(out.status.code(), Some(2));
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -1,24 +1,9 @@
 //! `towpath route` end to end: the binary on a committed fixture, its output checked against the
 //! instance independently, and refused input reported with file, line and problem.
 
-use std::path::PathBuf;
-use std::process::Command;
+use super::common::*;
 
 use towpath_coverage::{read_instance, RppModel};
-
-fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(name)
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("towpath-cli-route-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-fn towpath() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_towpath"))
-}
 
 /// Length of a walk, recomputed from the instance: consecutive vertices must be joined by the
 /// stated edge.
@@ -43,7 +28,7 @@ fn routes_the_fixture_optimally() {
         let m = RppModel::new(read_instance(&text).unwrap()).unwrap();
         towpath_seq::solve_exact(m.problem()).unwrap().unwrap().cost
     };
-    let out_file = scratch("route.json");
+    let out_file = scratch_file("route.json");
     let out = towpath()
         .args(["route", path.to_str().unwrap(), "--json", "--time-limit", "1", "-o", out_file.to_str().unwrap()])
         .output()
@@ -71,7 +56,7 @@ fn refused_input_names_file_line_and_problem() {
     let text = std::fs::read_to_string(fixture("rpp_6re.json")).unwrap();
     let bad = text.replacen("{\"a\": 0, \"b\": 2,", "{\"a\": 0, \"b\": 99,", 1);
     assert_ne!(bad, text);
-    let path = scratch("bad.json");
+    let path = scratch_file("bad.json");
     std::fs::write(&path, &bad).unwrap();
     let out = towpath().args(["route", path.to_str().unwrap()]).output().unwrap();
     assert_eq!(out.status.code(), Some(2));
@@ -88,7 +73,7 @@ fn refused_input_names_file_line_and_problem() {
 
 #[test]
 fn generated_instances_are_saved_and_reread() {
-    let inst = scratch("gen.json");
+    let inst = scratch_file("gen.json");
     let out = towpath()
         .args(["route", "--generate", "10", "--generate-seed", "4", "--time-limit", "0.3", "--threads", "1"])
         .args(["--save-instance", inst.to_str().unwrap(), "--json"])

@@ -1,42 +1,27 @@
 //! `towpath convert` end to end: a converted file solves to answers that price the same in the
 //! original file.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+use super::common::*;
 
 use towpath_formats::read_instance;
-
-fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../towpath-formats/tests/data").join(name)
-}
-
-fn towpath(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_towpath")).args(args).output().expect("the binary runs")
-}
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("towpath-convert-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// Converts `file`, solves the JSON with a fixed budget, and prices the answer in the original
 /// file: the cost the solver reports for the JSON must be the original's cost of that route.
 fn converted_answer_prices_the_same(file: &str, matrix: bool) {
-    let dir = temp_dir(&format!("{}-{matrix}", file.replace('.', "_")));
+    let dir = scratch(&format!("{}-{matrix}", file.replace('.', "_")));
     let json = dir.join("problem.json");
-    let input = fixture(file);
+    let input = data(file);
     let mut args = vec!["convert", input.to_str().unwrap(), "--to", "json", "-o", json.to_str().unwrap()];
     if matrix {
         args.push("--matrix");
     }
-    let out = towpath(&args);
+    let out = towpath_out(&args);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = std::fs::read_to_string(&json).unwrap();
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(v["states"]["matrix"].is_array(), matrix || !v["states"]["points"].is_array());
 
-    let out = towpath(&["solve", json.to_str().unwrap(), "--json", "--iterations", "300", "--threads", "1"]);
+    let out = towpath_out(&["solve", json.to_str().unwrap(), "--json", "--iterations", "300", "--threads", "1"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let answer: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let original = read_instance(&input).unwrap();
@@ -85,8 +70,8 @@ fn converted_sop_gtsp_and_pcglns_answers_price_the_same_in_the_original() {
 
 #[test]
 fn stdout_output_is_one_json_problem() {
-    let input = fixture("br17.atsp");
-    let out = towpath(&["convert", input.to_str().unwrap()]);
+    let input = data("br17.atsp");
+    let out = towpath_out(&["convert", input.to_str().unwrap()]);
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["name"], "br17");
@@ -96,11 +81,11 @@ fn stdout_output_is_one_json_problem() {
 
 #[test]
 fn refuses_to_overwrite_the_input_and_bad_files() {
-    let dir = temp_dir("refuse");
+    let dir = scratch("refuse");
     let copy = dir.join("burma14.tsp");
-    std::fs::copy(fixture("burma14.tsp"), &copy).unwrap();
+    std::fs::copy(data("burma14.tsp"), &copy).unwrap();
     let before = std::fs::read(&copy).unwrap();
-    let out = towpath(&["convert", copy.to_str().unwrap(), "-o", copy.to_str().unwrap()]);
+    let out = towpath_out(&["convert", copy.to_str().unwrap(), "-o", copy.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("would overwrite the input"));
     assert_eq!(std::fs::read(&copy).unwrap(), before, "the input is untouched");
@@ -108,7 +93,7 @@ fn refuses_to_overwrite_the_input_and_bad_files() {
     let bad = dir.join("bad.tsp");
     std::fs::write(&bad, "NAME: bad\nTYPE: TSP\nDIMENSION: 2\nEDGE_WEIGHT_TYPE: EUC_2D\nNODE_COORD_SECTION\n1 0 x\n")
         .unwrap();
-    let out = towpath(&["convert", bad.to_str().unwrap()]);
+    let out = towpath_out(&["convert", bad.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("bad.tsp:6"), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(out.stdout.is_empty());

@@ -1,0 +1,10 @@
+//! The `towpath` binary end to end, one test binary with a module per command (helpers in
+//! `common`).
+
+mod afp;
+mod common;
+mod convert;
+mod layup;
+mod outputs_and_pipes;
+mod route;
+mod solve;

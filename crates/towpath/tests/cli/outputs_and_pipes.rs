@@ -1,0 +1,211 @@
+//! One rule for every command's files and standard output: a closed pipe ends printing quietly
+//! (the run still does its work), outputs never replace inputs or each other, a failed run writes
+//! nothing, and a bad output path is the user's error (exit code 2), not a bug.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use super::common::*;
+
+/// Runs a command whose stdout is closed before it prints: it must exit 0 with nothing on stderr
+/// but, possibly, a progress bar.
+fn closed_stdout(cmd: &mut Command) {
+    let mut child = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("the binary runs");
+    drop(child.stdout.take());
+    let mut err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        e.read_to_string(&mut err).unwrap();
+    }
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(0), "{cmd:?}: {err}");
+    assert!(!err.contains("panicked") && !err.contains("Broken pipe"), "{cmd:?}: {err}");
+}
+
+/// The demo's files in a fresh folder.
+fn demo(tag: &str) -> PathBuf {
+    let d = scratch(tag);
+    let (code, _, err) = run(towpath().args(["demo", "--time-limit", "0.05", "--dir"]).arg(&d));
+    assert_eq!(code, 0, "{err}");
+    d
+}
+
+fn afp_args(cmd: &mut Command, d: &Path) {
+    cmd.arg("--machine").arg(d.join("gantry-afp.toml")).arg("--dialect").arg(d.join("dialect.toml"));
+}
+
+#[test]
+fn every_command_ends_quietly_on_a_closed_stdout() {
+    let d = demo("pipes");
+    closed_stdout(towpath().args(["demo", "--time-limit", "0.05", "--dir"]).arg(d.join("again")));
+    assert!(d.join("again/planar-45.opt.nc").exists(), "the demo still wrote its files");
+
+    let out = d.join("p45.nc");
+    let mut opt = towpath();
+    opt.arg("optimize").arg(d.join("planar-45.nc")).args(["--iterations", "200", "-o"]).arg(&out);
+    afp_args(&mut opt, &d);
+    closed_stdout(&mut opt);
+    assert!(out.exists(), "optimize still wrote its output");
+
+    let mut ver = towpath();
+    ver.arg("verify").arg(d.join("planar-45.nc")).arg(&out);
+    afp_args(&mut ver, &d);
+    closed_stdout(&mut ver);
+
+    closed_stdout(towpath().arg("solve").arg(data("att48.tsp")).args(["--iterations", "100", "--threads", "1"]));
+    closed_stdout(towpath().arg("convert").arg(data("att48.tsp")));
+    closed_stdout(towpath().arg("route").arg(fixture("rpp_6re.json")).args(["--time-limit", "0.2"]));
+    let courses = d.join("c.json");
+    closed_stdout(
+        towpath()
+            .args(["layup", "plane:a=200,b=100", "--angle", "30", "--tow-width", "6.35", "--tows", "4", "-o"])
+            .arg(&courses),
+    );
+    assert!(courses.exists(), "layup still wrote its courses");
+}
+
+#[test]
+fn outputs_never_replace_inputs_or_each_other() {
+    let d = scratch("clobber");
+    let mesh = d.join("m.stl");
+    let (code, _, err) = run(towpath()
+        .args(["layup", "plane:a=200,b=100", "--angle", "0", "--tow-width", "6.35", "--tows", "4", "-o"])
+        .arg(d.join("first.json"))
+        .arg("--write-mesh")
+        .arg(&mesh));
+    assert_eq!(code, 0, "{err}");
+    let before = std::fs::read(&mesh).unwrap();
+    std::fs::hard_link(&mesh, d.join("hard.stl")).unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(&mesh, d.join("soft.stl")).unwrap();
+    let layup = |extra: &[&str]| {
+        let mut c = towpath();
+        c.current_dir(&d).args(["layup", "m.stl", "--angle", "0", "--tow-width", "6.35", "--tows", "4"]).args(extra);
+        run(&mut c)
+    };
+    for extra in [
+        &["-o", "m.stl"][..],
+        &["-o", "x.json", "--write-mesh", "hard.stl"],
+        &["-o", "x.json", "--write-mesh", "soft.stl"],
+        &["-o", "x.json", "--gcode", "x.json"],
+        &["-o", "x.json", "--csv", "./x.json"],
+    ] {
+        let (code, _, err) = layup(extra);
+        assert_eq!(code, 2, "{extra:?}: {err}");
+        assert!(err.contains("would overwrite") || err.contains("same file"), "{extra:?}: {err}");
+    }
+    assert_eq!(std::fs::read(&mesh).unwrap(), before, "the input mesh is untouched");
+    assert!(!d.join("x.json").exists(), "a refused run writes nothing");
+
+    let (code, _, err) = run(towpath().current_dir(&d).args(["route", "--generate", "5", "--save-instance", "g.json"]));
+    assert_eq!(code, 0, "{err}");
+    let graph = std::fs::read(d.join("g.json")).unwrap();
+    for extra in [&["-o", "g.json"][..], &["--save-instance", "g.json"], &["-o", "r.json", "--save-instance", "r.json"]]
+    {
+        let (code, _, err) =
+            run(towpath().current_dir(&d).args(["route", "g.json", "--time-limit", "0.1"]).args(extra));
+        assert_eq!(code, 2, "{extra:?}: {err}");
+    }
+    assert_eq!(std::fs::read(d.join("g.json")).unwrap(), graph, "the graph is untouched");
+
+    std::fs::copy(data("att48.tsp"), d.join("a.tsp")).unwrap();
+    std::fs::hard_link(d.join("a.tsp"), d.join("a-link.tsp")).unwrap();
+    let (code, _, err) = run(towpath().current_dir(&d).args(["convert", "a.tsp", "-o", "a-link.tsp"]));
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(std::fs::read(d.join("a.tsp")).unwrap(), std::fs::read(data("att48.tsp")).unwrap());
+}
+
+#[test]
+fn a_failed_run_writes_nothing() {
+    let d = demo("failed");
+    // The report names a folder: refused before any work, the output not written.
+    std::fs::create_dir_all(d.join("reports")).unwrap();
+    std::fs::write(d.join("keep.nc"), "mine").unwrap();
+    let mut opt = towpath();
+    opt.arg("optimize")
+        .arg(d.join("planar-45.nc"))
+        .arg("-o")
+        .arg(d.join("keep.nc"))
+        .arg("--report")
+        .arg(d.join("reports"));
+    afp_args(&mut opt, &d);
+    let (code, _, err) = run(&mut opt);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(std::fs::read_to_string(d.join("keep.nc")).unwrap(), "mine");
+
+    std::fs::write(d.join("keep.json"), "mine").unwrap();
+    let (code, _, err) = run(towpath()
+        .args(["layup", "plane:a=200,b=100", "--angle", "0", "--tow-width", "6.35", "--tows", "4", "-o"])
+        .arg(d.join("keep.json"))
+        .arg("--gcode")
+        .arg(d.join("reports")));
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(std::fs::read_to_string(d.join("keep.json")).unwrap(), "mine");
+
+    // A program that fails to parse: nothing written, no folder made, no temporary file left.
+    std::fs::write(d.join("bad.nc"), "G1 X1\nM20\nG0 X5\n").unwrap();
+    let mut opt = towpath();
+    opt.arg("optimize").arg(d.join("bad.nc")).arg("-o").arg(d.join("new/out.nc"));
+    afp_args(&mut opt, &d);
+    let (code, _, err) = run(&mut opt);
+    assert_eq!(code, 2, "{err}");
+    assert!(!d.join("new").exists(), "{err}");
+    let leftovers: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn bad_output_paths_are_the_users_error() {
+    let d = scratch("paths");
+    std::fs::write(d.join("file"), "x").unwrap();
+    let cases: Vec<Vec<String>> = vec![
+        vec!["convert".into(), data("att48.tsp").display().to_string(), "-o".into(), d.display().to_string()],
+        vec![
+            "convert".into(),
+            data("att48.tsp").display().to_string(),
+            "-o".into(),
+            d.join("file/x.json").display().to_string(),
+        ],
+        vec!["route".into(), "--generate".into(), "4".into(), "-o".into(), d.display().to_string()],
+        vec![
+            "layup".into(),
+            "plane:a=200,b=100".into(),
+            "--angle".into(),
+            "0".into(),
+            "--tow-width".into(),
+            "6".into(),
+            "--tows".into(),
+            "2".into(),
+            "-o".into(),
+            d.join("file/c.json").display().to_string(),
+        ],
+    ];
+    for args in cases {
+        let (code, _, err) = run(towpath().args(&args));
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(!err.contains("bug"), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn demo_replaces_only_its_own_files() {
+    let d = demo("demo-own");
+    // A second run replaces the demo's own files.
+    let (code, _, err) = run(towpath().args(["demo", "--time-limit", "0.05", "--dir"]).arg(&d));
+    assert_eq!(code, 0, "{err}");
+    // A file of the user's own with a demo name is kept unless --force.
+    let user = scratch("demo-user");
+    std::fs::write(user.join("planar-45.nc"), "mine").unwrap();
+    let (code, _, err) = run(towpath().args(["demo", "--time-limit", "0.05", "--dir"]).arg(&user));
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("planar-45.nc") && err.contains("--force"), "{err}");
+    assert_eq!(std::fs::read_to_string(user.join("planar-45.nc")).unwrap(), "mine");
+    assert!(!user.join("planar-0.nc").exists(), "a refused demo writes nothing");
+    let (code, _, err) = run(towpath().args(["demo", "--time-limit", "0.05", "--force", "--dir"]).arg(&user));
+    assert_eq!(code, 0, "{err}");
+    assert_ne!(std::fs::read_to_string(user.join("planar-45.nc")).unwrap(), "mine");
+}
