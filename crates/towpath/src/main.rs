@@ -19,7 +19,7 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run the built-in demo: seed 000's AFP parts written, optimized, verified and reported.
+    /// Run the built-in demo: Doherty et al.'s (2022) AFP test parts written, optimized, verified and reported.
     Demo(cmd::demo::Args),
     /// Solve a TSPLIB (TSP, ATSP, SOP), GTSP-LIB, PCGLNS or towpath JSON problem file.
     Solve(cmd::solve::Args),
@@ -32,7 +32,7 @@ enum Command {
     Optimize(cmd::optimize::Args),
     /// Check an optimized AFP program against its original and print the savings.
     Verify(cmd::verify::Args),
-    /// Integrate separate tool paths into one open route over a travel graph (seed 004's open rural postman).
+    /// Integrate separate tool paths into one open route over a travel graph (Tewolde & Sheng's (2008) open rural postman).
     Route(cmd::route::Args),
     /// Run a benchmark and print (or write into BENCHMARKS.md) its tables.
     Bench(cmd::bench::Args),
