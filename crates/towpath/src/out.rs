@@ -17,7 +17,7 @@ enum State {
 
 static STATE: Mutex<State> = Mutex::new(State::Open);
 
-/// Prints formatted text on standard output (use [`outln!`](crate::outln) / [`out!`](crate::out)).
+/// Prints formatted text on standard output (use [`outln!`](crate::outln!) / [`out!`](crate::out!)).
 pub fn print(args: std::fmt::Arguments<'_>) {
     let mut state = STATE.lock().unwrap_or_else(|p| p.into_inner());
     if !matches!(*state, State::Open) {
