@@ -146,7 +146,7 @@ impl Cell {
 
     /// The distance from segment `p q` to the nearest obstacle, or `cap` if nothing is nearer
     /// than `cap`. The search stops as soon as something is found at or below `stop`, returning
-    /// that distance (pass `stop = -1` for the exact minimum).
+    /// that distance (pass a negative `stop` for the exact minimum).
     pub fn segment_distance(&self, p: DVec3, q: DVec3, cap: f64, stop: f64) -> f64 {
         let (pa, d) = ([p.x, p.y, p.z], [q.x - p.x, q.y - p.y, q.z - p.z]);
         let mut best = cap;
@@ -155,10 +155,12 @@ impl Cell {
                 return TraversalAction::Prune;
             }
             if let Some(leaf) = node.leaf_data() {
+                let mut found = f64::INFINITY;
                 for t in self.leaf(leaf) {
-                    best = best.min(segment_triangle_dist(p, q, t));
+                    found = found.min(segment_triangle_dist(p, q, t));
                 }
-                if best <= stop {
+                best = best.min(found);
+                if found <= stop {
                     return TraversalAction::EarlyExit;
                 }
             }
@@ -189,12 +191,14 @@ impl Cell {
                 return TraversalAction::Prune;
             }
             if let Some(leaf) = node.leaf_data() {
+                let mut found = f64::INFINITY;
                 for t in self.leaf(leaf) {
                     for q in &quad {
-                        best = best.min(triangle_triangle_dist(q, t));
+                        found = found.min(triangle_triangle_dist(q, t));
                     }
                 }
-                if best <= stop {
+                best = best.min(found);
+                if found <= stop {
                     return TraversalAction::EarlyExit;
                 }
             }

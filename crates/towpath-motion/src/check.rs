@@ -211,17 +211,21 @@ impl Checker {
         let h = t1 - t0;
         let dev = bend * h * h / 8.0;
         let d = self.cell.segment_distance(p0.tool, p1.tool, cap_lb + dev, stop_ub - dev);
-        let (mut lb, mut ub, mut err, mut body) = (d - dev, d + dev, dev, Body::Tool);
+        // Nothing nearer than the cap: the lower bound is the cap itself (not a rounding below).
+        let capped = |l: f64, d: f64, cap: f64| if d >= cap { l.max(cap_lb) } else { l };
+        let (mut lb, mut ub, mut err, mut body) = (capped(d - dev, d, cap_lb + dev), d + dev, dev, Body::Tool);
         if let Some(head) = self.rig.head() {
-            if ub > stop_ub {
+            // The head need not be looked at when the tool point already settles the piece
+            // below `stop_ub` (a distance found, not the cap).
+            if !(ub <= stop_ub && d < cap_lb + dev) {
                 // The head's axis twists over the piece by e; the triangulated quadrilateral
                 // is within |e|/4 of the swept (bilinear) surface, both ways.
                 let e = ((p1.top - p1.bottom) - (p0.top - p0.bottom)).length();
                 let herr = dev + e / 4.0;
                 let r = head.radius;
-                let dq =
-                    self.cell.quad_distance(p0.bottom, p0.top, p1.top, p1.bottom, cap_lb + r + herr, stop_ub + r - herr);
-                let (hl, hu) = (dq - r - herr, dq - r + herr);
+                let cap = cap_lb + r + herr;
+                let dq = self.cell.quad_distance(p0.bottom, p0.top, p1.top, p1.bottom, cap, stop_ub + r - herr);
+                let (hl, hu) = (capped(dq - r - herr, dq, cap), dq - r + herr);
                 if hu < ub {
                     body = Body::Head;
                 }
