@@ -7,7 +7,7 @@ use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy, BvhNode, TraversalAction}
 use towpath_geom::{DVec3, Soup};
 
 use crate::error::CellError;
-use crate::geometry::{segment_hits_box, segment_triangle_dist, triangle_triangle_dist};
+use crate::geometry::{segment_box_linf, segment_hits_box, segment_triangle_dist, triangle_triangle_dist};
 
 /// Triangles per BVH leaf: consecutive triangles in Morton order of their centres share a leaf,
 /// which makes the tree several times quicker to build than one leaf per triangle.
@@ -205,6 +205,50 @@ impl Cell {
             TraversalAction::Continue
         });
         best
+    }
+
+    /// The least distance from segment `p q` to the obstacles, found best first (nearest BVH
+    /// node first, by its L∞ distance): the answer `d` (or `cap` when nothing is nearer)
+    /// is within `slack` above the truth — nodes that cannot hold anything nearer than
+    /// `d − slack` are not opened. Much quicker than the exact search when a long segment runs
+    /// at a near-constant distance from a dense mesh.
+    pub fn segment_min(&self, p: DVec3, q: DVec3, cap: f64, slack: f64) -> f64 {
+        let (pa, d) = ([p.x, p.y, p.z], [q.x - p.x, q.y - p.y, q.z - p.z]);
+        self.bvh
+            .find_best(
+                cap,
+                |node: &BvhNode, _| segment_box_linf(pa, d, arr(node.mins()), arr(node.maxs()), [0.0; 3]) + slack,
+                |leaf, _| Some(self.leaf(leaf).iter().map(|t| segment_triangle_dist(p, q, t)).fold(f64::INFINITY, f64::min)),
+            )
+            .map_or(cap, |(_, d)| d.min(cap))
+    }
+
+    /// [`Cell::quad_distance`] found best first, within `slack` above the truth like
+    /// [`Cell::segment_min`].
+    pub fn quad_min(&self, a0: DVec3, b0: DVec3, b1: DVec3, a1: DVec3, cap: f64, slack: f64) -> f64 {
+        let (m0, m1) = ((a0 + b0) * 0.5, (a1 + b1) * 0.5);
+        let (h0, h1) = (b0 - a0, b1 - a1);
+        let half = [
+            0.5 * h0.x.abs().max(h1.x.abs()),
+            0.5 * h0.y.abs().max(h1.y.abs()),
+            0.5 * h0.z.abs().max(h1.z.abs()),
+        ];
+        let quad = [[a0, b0, b1], [a0, b1, a1]];
+        let (pa, d) = ([m0.x, m0.y, m0.z], [m1.x - m0.x, m1.y - m0.y, m1.z - m0.z]);
+        self.bvh
+            .find_best(
+                cap,
+                |node: &BvhNode, _| segment_box_linf(pa, d, arr(node.mins()), arr(node.maxs()), half) + slack,
+                |leaf, _| {
+                    Some(
+                        self.leaf(leaf)
+                            .iter()
+                            .flat_map(|t| quad.iter().map(move |q| triangle_triangle_dist(q, t)))
+                            .fold(f64::INFINITY, f64::min),
+                    )
+                },
+            )
+            .map_or(cap, |(_, d)| d.min(cap))
     }
 
     /// The distance from point `p` to the nearest obstacle, or `cap` if nothing is nearer.

@@ -140,7 +140,6 @@ struct Piece {
     p1: Pose,
     lb: f64,
     ub: f64,
-    err: f64,
     body: Body,
 }
 
@@ -204,37 +203,46 @@ impl Checker {
     }
 
     /// Evaluates a piece: its distance bounds. The cell is queried only as far as can matter:
-    /// a piece whose lower bound would reach `cap_lb` is not looked at beyond (its bounds then
-    /// start at `cap_lb`), and the query stops as soon as the upper bound falls to `stop_ub`
-    /// (the lower bound is then not exact, but below `stop_ub` too).
-    fn piece(&self, bend: f64, t0: f64, t1: f64, p0: Pose, p1: Pose, cap_lb: f64, stop_ub: f64) -> Piece {
+    /// a piece whose lower bound would reach `cap_lb` is not looked at beyond (its lower bound
+    /// is then `cap_lb`). With `stop_ub`, a yes/no query: the search stops as soon as the upper
+    /// bound falls to `stop_ub` (the lower bound is then not exact, but below `stop_ub` too).
+    /// Without, a measurement: the cell is searched best first, to within a quarter of the
+    /// tolerance (taken off the lower bound).
+    fn piece(&self, bend: f64, t0: f64, t1: f64, p0: Pose, p1: Pose, cap_lb: f64, stop_ub: Option<f64>) -> Piece {
+        let slack = if stop_ub.is_none() { 0.25 * self.opts.tolerance } else { 0.0 };
         let h = t1 - t0;
         let dev = bend * h * h / 8.0;
-        let d = self.cell.segment_distance(p0.tool, p1.tool, cap_lb + dev, stop_ub - dev);
+        let cap = cap_lb + dev + slack;
+        let d = match stop_ub {
+            Some(s) => self.cell.segment_distance(p0.tool, p1.tool, cap, s - dev),
+            None => self.cell.segment_min(p0.tool, p1.tool, cap, slack),
+        };
         // Nothing nearer than the cap: the lower bound is the cap itself (not a rounding below).
-        let capped = |l: f64, d: f64, cap: f64| if d >= cap { l.max(cap_lb) } else { l };
-        let (mut lb, mut ub, mut err, mut body) = (capped(d - dev, d, cap_lb + dev), d + dev, dev, Body::Tool);
+        let (mut lb, mut ub, mut body) = (if d >= cap { cap_lb } else { d - dev - slack }, d + dev, Body::Tool);
         if let Some(head) = self.rig.head() {
-            // The head need not be looked at when the tool point already settles the piece
-            // below `stop_ub` (a distance found, not the cap).
-            if !(ub <= stop_ub && d < cap_lb + dev) {
+            // The head need not be looked at when the tool point already settles a yes/no
+            // piece below `stop_ub` (a distance found, not the cap).
+            let settled = stop_ub.is_some_and(|s| ub <= s && d < cap);
+            if !settled {
                 // The head's axis twists over the piece by e; the triangulated quadrilateral
                 // is within |e|/4 of the swept (bilinear) surface, both ways.
                 let e = ((p1.top - p1.bottom) - (p0.top - p0.bottom)).length();
                 let herr = dev + e / 4.0;
                 let r = head.radius;
-                let cap = cap_lb + r + herr;
-                let dq = self.cell.quad_distance(p0.bottom, p0.top, p1.top, p1.bottom, cap, stop_ub + r - herr);
-                let (hl, hu) = (capped(dq - r - herr, dq, cap), dq - r + herr);
+                let cap = cap_lb + r + herr + slack;
+                let dq = match stop_ub {
+                    Some(s) => self.cell.quad_distance(p0.bottom, p0.top, p1.top, p1.bottom, cap, s + r - herr),
+                    None => self.cell.quad_min(p0.bottom, p0.top, p1.top, p1.bottom, cap, slack),
+                };
+                let (hl, hu) = (if dq >= cap { cap_lb } else { dq - r - herr - slack }, dq - r + herr);
                 if hu < ub {
                     body = Body::Head;
                 }
                 lb = lb.min(hl);
                 ub = ub.min(hu);
-                err = err.max(herr);
             }
         }
-        Piece { t0, t1, p0, p1, lb, ub, err, body }
+        Piece { t0, t1, p0, p1, lb, ub, body }
     }
 
     /// True when the move's path over [ta, tb] keeps at least `c` from every obstacle, decided
@@ -248,11 +256,11 @@ impl Checker {
         let (pa, pb) = (path.pose(ta, &mut buf), path.pose(tb, &mut buf));
         let mut stack = vec![(ta, tb, pa, pb)];
         while let Some((t0, t1, p0, p1)) = stack.pop() {
-            let p = self.piece(path.bend, t0, t1, p0, p1, c, c);
+            let p = self.piece(path.bend, t0, t1, p0, p1, c, Some(c));
             if p.lb >= c {
                 continue;
             }
-            if p.ub <= c || p.err <= tol || t1 - t0 < MIN_PIECE {
+            if p.ub <= c || p.ub - p.lb <= tol || t1 - t0 < MIN_PIECE {
                 return false;
             }
             let tm = 0.5 * (t0 + t1);
@@ -270,7 +278,7 @@ impl Checker {
         let horizon = self.opts.horizon;
         let mut buf = Vec::with_capacity(self.rig.dim());
         let (pa, pb) = (path.pose(ta, &mut buf), path.pose(tb, &mut buf));
-        let first = self.piece(path.bend, ta, tb, pa, pb, horizon, f64::NEG_INFINITY);
+        let first = self.piece(path.bend, ta, tb, pa, pb, horizon, None);
         let mut upper = horizon;
         let mut at = None;
         note(&first, &mut upper, &mut at);
@@ -286,14 +294,14 @@ impl Checker {
             if p.lb >= upper - tol {
                 break p.lb.min(resolved);
             }
-            if p.err <= 0.5 * tol || p.t1 - p.t0 < MIN_PIECE {
+            if p.ub - p.lb <= tol || p.t1 - p.t0 < MIN_PIECE {
                 resolved = resolved.min(p.lb);
                 continue;
             }
             let tm = 0.5 * (p.t0 + p.t1);
             let pm = path.pose(tm, &mut buf);
             for (t0, t1, p0, p1) in [(p.t0, tm, p.p0, pm), (tm, p.t1, pm, p.p1)] {
-                let c = self.piece(path.bend, t0, t1, p0, p1, upper, f64::NEG_INFINITY);
+                let c = self.piece(path.bend, t0, t1, p0, p1, upper, None);
                 note(&c, &mut upper, &mut at);
                 if c.lb < upper {
                     heap.push(c);
@@ -388,13 +396,15 @@ impl Checker {
         MoveCheck { min_clearance, closest, collision, near_miss, limits: self.limit_violations(from, to) }
     }
 
-    /// True when the move keeps the clearance (and, in the contact zones of an on-part end, is
-    /// free of collisions); quicker than [`Checker::check`], which also measures. Limits are
-    /// not looked at.
+    /// True when the move keeps the clearance plus the tolerance (and, in the contact zones of
+    /// an on-part end, is free of collisions); quicker than [`Checker::check`], which also
+    /// measures. A move it passes is clear by [`Checker::check`] too (the tolerance covers the
+    /// measurement's error); one within the tolerance above the clearance may fail it. Limits
+    /// are not looked at.
     pub fn is_clear(&self, from: &[f64], to: &[f64], contact: Contact) -> bool {
         let path = self.path(from, to);
         let ((a, b), zones) = self.ranges(&path, contact);
-        self.clear_over(&path, a, b, self.opts.clearance)
+        self.clear_over(&path, a, b, self.opts.clearance + self.opts.tolerance)
             && zones.iter().all(|&(za, zb)| self.clear_over(&path, za, zb, self.opts.tolerance))
     }
 
@@ -402,6 +412,6 @@ impl Checker {
     /// the horizon; exact up to rounding).
     pub fn state_clearance(&self, state: &[f64]) -> f64 {
         let p = self.rig.pose(state);
-        self.piece(0.0, 0.0, 0.0, p, p, self.opts.horizon, f64::NEG_INFINITY).lb.clamp(0.0, self.opts.horizon)
+        self.piece(0.0, 0.0, 0.0, p, p, self.opts.horizon, None).lb.clamp(0.0, self.opts.horizon)
     }
 }

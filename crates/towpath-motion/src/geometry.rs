@@ -134,6 +134,43 @@ pub(crate) fn segment_hits_box(p: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64;
     true
 }
 
+/// The L∞ (largest per-axis) distance between the segment `p + s·d`, s ∈ [0, 1], and the box
+/// `[lo − grow, hi + grow]`: a lower bound of the Euclidean distance, exact for boxes in the
+/// segment's direction. It is the least g at which the segment meets the box grown by g: the
+/// minimum over s of the largest of six linear functions (how far each face is exceeded), which
+/// lies at an end or where a rising and a falling function cross.
+pub(crate) fn segment_box_linf(p: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3], grow: [f64; 3]) -> f64 {
+    if segment_hits_box(p, d, lo, hi, grow) {
+        return 0.0;
+    }
+    // Lines a + b·s: (lo − grow − p) − d·s and (p − hi − grow) + d·s per axis.
+    let mut a = [0.0; 6];
+    let mut b = [0.0; 6];
+    for k in 0..3 {
+        a[2 * k] = lo[k] - grow[k] - p[k];
+        b[2 * k] = -d[k];
+        a[2 * k + 1] = p[k] - hi[k] - grow[k];
+        b[2 * k + 1] = d[k];
+    }
+    let g = |s: f64| (0..6).fold(0.0f64, |m, i| m.max(a[i] + b[i] * s));
+    let mut best = g(0.0).min(g(1.0));
+    for i in 0..6 {
+        if b[i] <= 0.0 {
+            continue;
+        }
+        for j in 0..6 {
+            if b[j] >= 0.0 {
+                continue;
+            }
+            let s = (a[j] - a[i]) / (b[i] - b[j]);
+            if s > 0.0 && s < 1.0 {
+                best = best.min(g(s));
+            }
+        }
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -165,5 +202,27 @@ mod tests {
         // A segment that stops short.
         assert!(!segment_hits_box([-5.0, 0.5, 0.5], [3.0, 0.0, 0.0], lo, hi, [0.5; 3]));
         assert!(segment_hits_box([-5.0, 0.5, 0.5], [4.6, 0.0, 0.0], lo, hi, [0.5; 3]));
+        // L∞ distances: 2 above the box; a diagonal passing the corner; the least grow at
+        // which the slab test passes, by bisection.
+        assert!((segment_box_linf([-5.0, 0.5, 3.0], [10.0, 0.0, 0.0], lo, hi, [0.0; 3]) - 2.0).abs() < 1e-12);
+        let mut x = 12345u64;
+        let mut r = || {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (x >> 11) as f64 / (1u64 << 53) as f64 * 10.0 - 5.0
+        };
+        for _ in 0..2000 {
+            let (p, d) = ([r(), r(), r()], [r(), r(), r()]);
+            let g = segment_box_linf(p, d, lo, hi, [0.0; 3]);
+            let (mut a, mut b) = (0.0, 20.0);
+            for _ in 0..60 {
+                let m = 0.5 * (a + b);
+                if segment_hits_box(p, d, lo, hi, [m; 3]) {
+                    b = m;
+                } else {
+                    a = m;
+                }
+            }
+            assert!((g - b).abs() < 1e-9, "{g} {b}");
+        }
     }
 }

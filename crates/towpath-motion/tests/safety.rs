@@ -236,12 +236,13 @@ fn compare_with_reference(
         } else {
             clear += 1;
         }
-        // The quick test agrees with the measurement.
-        assert_eq!(
-            checker.is_clear(&from, &to, Contact::None),
-            !got.collision && !got.near_miss,
-            "move {m}: {got:?}, reference [{lower}, {upper}]"
-        );
+        // The quick test agrees with the measurement (up to the tolerance it keeps in hand).
+        let quick = checker.is_clear(&from, &to, Contact::None);
+        if quick {
+            assert!(!got.collision && !got.near_miss, "move {m}: {got:?}");
+        } else {
+            assert!(l < opts.clearance + 2.0 * tol, "move {m}: {got:?}, reference [{lower}, {upper}]");
+        }
     }
     // The random set-up exercises all three outcomes.
     assert!(collisions > 0 && clear > 0, "{collisions} collisions, {near} near misses, {clear} clear");
