@@ -106,6 +106,7 @@ fn on_two_threads<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> 
 
 fn main() {
     let runs: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(5);
+    let count: usize = std::env::args().nth(2).and_then(|s| s.parse().ok()).unwrap_or(10_000);
     let tris = mold();
     let machine = Machine::from_toml_str(GANTRY).expect("machine");
     let rig = Arc::new(Rig::new(&machine, Some(Head { radius: 30.0, bottom: 35.0, top: 300.0 })).expect("rig"));
@@ -116,7 +117,7 @@ fn main() {
         let x = if on_stringer { x - 150.0 } else { x };
         vec![x, y, height(x, y) + 25.0, 360.0 * rng.next() - 180.0]
     };
-    let pairs: Vec<(Vec<f64>, Vec<f64>)> = (0..10_000).map(|_| (end(), end())).collect();
+    let pairs: Vec<(Vec<f64>, Vec<f64>)> = (0..count).map(|_| (end(), end())).collect();
     println!("mold: {} triangles; {} transits; {runs} runs", tris.len(), pairs.len());
     let (mut build, mut check, mut plan) = (Vec::new(), Vec::new(), Vec::new());
     let mut summary = String::new();
@@ -124,9 +125,11 @@ fn main() {
         let t0 = Instant::now();
         let cell = Arc::new(Cell::from_triangles(tris.clone()));
         let t1 = Instant::now();
+        eprintln!("built in {:?}", t1 - t0);
         let checker = Checker::new(cell, rig.clone(), CheckOptions::default());
         let checks = on_two_threads(&pairs, |(a, b)| checker.check(a, b, Contact::None));
         let t2 = Instant::now();
+        eprintln!("checked in {:?}", t2 - t1);
         let planner = Planner::new(checker.clone(), PlanOptions::default()).expect("planner");
         let plans = on_two_threads(&pairs, |(a, b)| planner.plan(a, b));
         let t3 = Instant::now();

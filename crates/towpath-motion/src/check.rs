@@ -28,8 +28,10 @@ pub struct CheckOptions {
     /// The tolerance, mm (default 0.01): reported clearances are lower bounds at most this far
     /// below the true minimum, and a move that comes within it of an obstacle is a collision.
     pub tolerance: f64,
-    /// Clearances are measured up to this distance, mm (default 50): a move that stays farther
-    /// from everything reports this value.
+    /// Clearances are measured up to this distance, mm (default 10, twice the default
+    /// clearance; never below the clearance): a move that stays farther from everything
+    /// reports this value ("at least"). Measuring far clearances exactly costs more, as more
+    /// of the mesh lies within reach.
     pub horizon: f64,
     /// On a move that starts or ends on the part, the stretch of this length (mm along the tool
     /// point's path) next to its on-part end is checked for collisions only (default 10).
@@ -41,7 +43,7 @@ pub struct CheckOptions {
 
 impl Default for CheckOptions {
     fn default() -> Self {
-        CheckOptions { clearance: 5.0, tolerance: 0.01, horizon: 50.0, contact_zone: 10.0, contact_skip: 1.0 }
+        CheckOptions { clearance: 5.0, tolerance: 0.01, horizon: 10.0, contact_zone: 10.0, contact_skip: 1.0 }
     }
 }
 
@@ -177,7 +179,7 @@ impl Checker {
     /// A checker of moves of `rig` against `cell`.
     pub fn new(cell: Arc<Cell>, rig: Arc<Rig>, opts: CheckOptions) -> Checker {
         let mut opts = opts;
-        opts.horizon = opts.horizon.max(opts.clearance);
+        opts.horizon = opts.horizon.max(opts.clearance + opts.tolerance);
         Checker { cell, rig, opts }
     }
 

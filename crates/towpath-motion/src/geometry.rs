@@ -134,41 +134,59 @@ pub(crate) fn segment_hits_box(p: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64;
     true
 }
 
-/// The L∞ (largest per-axis) distance between the segment `p + s·d`, s ∈ [0, 1], and the box
-/// `[lo − grow, hi + grow]`: a lower bound of the Euclidean distance, exact for boxes in the
-/// segment's direction. It is the least g at which the segment meets the box grown by g: the
-/// minimum over s of the largest of six linear functions (how far each face is exceeded), which
-/// lies at an end or where a rising and a falling function cross.
-pub(crate) fn segment_box_linf(p: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3], grow: [f64; 3]) -> f64 {
-    if segment_hits_box(p, d, lo, hi, grow) {
-        return 0.0;
-    }
-    // Lines a + b·s: (lo − grow − p) − d·s and (p − hi − grow) + d·s per axis.
-    let mut a = [0.0; 6];
-    let mut b = [0.0; 6];
+/// The Euclidean distance between the segment `p + s·d`, s ∈ [0, 1], and the box
+/// `[lo − grow, hi + grow]`. A point's squared distance to a box is the sum over the axes of
+/// its squared distance to each interval, which along the segment is a convex piecewise
+/// quadratic in s with breaks where the segment crosses a face plane: minimized exactly on each
+/// piece.
+pub(crate) fn segment_box_dist(p: [f64; 3], d: [f64; 3], lo: [f64; 3], hi: [f64; 3], grow: [f64; 3]) -> f64 {
+    let lo = [lo[0] - grow[0], lo[1] - grow[1], lo[2] - grow[2]];
+    let hi = [hi[0] + grow[0], hi[1] + grow[1], hi[2] + grow[2]];
+    let mut ts = [0.0f64; 8];
+    let mut n = 0;
+    ts[n] = 0.0;
+    n += 1;
     for k in 0..3 {
-        a[2 * k] = lo[k] - grow[k] - p[k];
-        b[2 * k] = -d[k];
-        a[2 * k + 1] = p[k] - hi[k] - grow[k];
-        b[2 * k + 1] = d[k];
-    }
-    let g = |s: f64| (0..6).fold(0.0f64, |m, i| m.max(a[i] + b[i] * s));
-    let mut best = g(0.0).min(g(1.0));
-    for i in 0..6 {
-        if b[i] <= 0.0 {
-            continue;
+        if d[k] != 0.0 {
+            for face in [lo[k], hi[k]] {
+                let t = (face - p[k]) / d[k];
+                if t > 0.0 && t < 1.0 {
+                    ts[n] = t;
+                    n += 1;
+                }
+            }
         }
-        for j in 0..6 {
-            if b[j] >= 0.0 {
+    }
+    ts[n] = 1.0;
+    n += 1;
+    let ts = &mut ts[..n];
+    ts.sort_unstable_by(f64::total_cmp);
+    let mut best = f64::INFINITY;
+    for w in ts.windows(2) {
+        let (ta, tb) = (w[0], w[1]);
+        let tm = 0.5 * (ta + tb);
+        // On this piece each axis is below, inside or above its interval throughout.
+        let (mut a2, mut ab, mut b2) = (0.0, 0.0, 0.0);
+        for k in 0..3 {
+            let x = p[k] + tm * d[k];
+            let (a, b) = if x < lo[k] {
+                (lo[k] - p[k], -d[k])
+            } else if x > hi[k] {
+                (p[k] - hi[k], d[k])
+            } else {
                 continue;
-            }
-            let s = (a[j] - a[i]) / (b[i] - b[j]);
-            if s > 0.0 && s < 1.0 {
-                best = best.min(g(s));
-            }
+            };
+            a2 += a * a;
+            ab += a * b;
+            b2 += b * b;
+        }
+        let t = if b2 > 0.0 { (-ab / b2).clamp(ta, tb) } else { ta };
+        best = best.min((a2 + 2.0 * ab * t + b2 * t * t).max(0.0));
+        if best == 0.0 {
+            return 0.0;
         }
     }
-    best
+    best.sqrt()
 }
 
 #[cfg(test)]
@@ -202,27 +220,29 @@ mod tests {
         // A segment that stops short.
         assert!(!segment_hits_box([-5.0, 0.5, 0.5], [3.0, 0.0, 0.0], lo, hi, [0.5; 3]));
         assert!(segment_hits_box([-5.0, 0.5, 0.5], [4.6, 0.0, 0.0], lo, hi, [0.5; 3]));
-        // L∞ distances: 2 above the box; a diagonal passing the corner; the least grow at
-        // which the slab test passes, by bisection.
-        assert!((segment_box_linf([-5.0, 0.5, 3.0], [10.0, 0.0, 0.0], lo, hi, [0.0; 3]) - 2.0).abs() < 1e-12);
+        // Segment-box distances: 2 above the box; against the least distance of 20,001 points
+        // of random segments, and never more than the distance of either end.
+        assert!((segment_box_dist([-5.0, 0.5, 3.0], [10.0, 0.0, 0.0], lo, hi, [0.0; 3]) - 2.0).abs() < 1e-12);
+        assert!((segment_box_dist([-5.0, 0.5, 3.0], [10.0, 0.0, 0.0], lo, hi, [0.5; 3]) - 1.5).abs() < 1e-12);
         let mut x = 12345u64;
         let mut r = || {
             x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (x >> 11) as f64 / (1u64 << 53) as f64 * 10.0 - 5.0
         };
-        for _ in 0..2000 {
+        let point_box = |q: [f64; 3]| {
+            (0..3).map(|k| (lo[k] - q[k]).max(q[k] - hi[k]).max(0.0).powi(2)).sum::<f64>().sqrt()
+        };
+        for _ in 0..300 {
             let (p, d) = ([r(), r(), r()], [r(), r(), r()]);
-            let g = segment_box_linf(p, d, lo, hi, [0.0; 3]);
-            let (mut a, mut b) = (0.0, 20.0);
-            for _ in 0..60 {
-                let m = 0.5 * (a + b);
-                if segment_hits_box(p, d, lo, hi, [m; 3]) {
-                    b = m;
-                } else {
-                    a = m;
-                }
-            }
-            assert!((g - b).abs() < 1e-9, "{g} {b}");
+            let g = segment_box_dist(p, d, lo, hi, [0.0; 3]);
+            let sampled = (0..=20_000)
+                .map(|i| {
+                    let s = i as f64 / 20_000.0;
+                    point_box([p[0] + s * d[0], p[1] + s * d[1], p[2] + s * d[2]])
+                })
+                .fold(f64::INFINITY, f64::min);
+            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            assert!(g <= sampled + 1e-9 && g >= sampled - len / 20_000.0 - 1e-9, "{g} {sampled}");
         }
     }
 }
