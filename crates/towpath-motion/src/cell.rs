@@ -11,7 +11,7 @@ use crate::geometry::{segment_box_dist, segment_hits_box, segment_triangle_dist,
 
 /// Triangles per BVH leaf: consecutive triangles in Morton order of their centres share a leaf,
 /// which makes the tree several times quicker to build than one leaf per triangle.
-const LEAF_SIZE: usize = 4;
+const LEAF_SIZE: usize = 8;
 
 /// Cells with more triangles than this build their hierarchy in two halves on two threads.
 const SPLIT_ABOVE: usize = 100_000;
