@@ -279,7 +279,8 @@ mod tests {
         // The part turned +90° about +x: in the part frame the tool stands at +y and points
         // towards −y, at the axis.
         assert!(close(k.part_tool_axis(&[0.0, 100.0, 90.0]), [0.0, -1.0, 0.0]));
-        let mut s = Machine::new("s", vec![Axis::new("Z", AxisKind::Linear), Axis::new("C", AxisKind::Rotary)]).unwrap();
+        let mut s =
+            Machine::new("s", vec![Axis::new("Z", AxisKind::Linear), Axis::new("C", AxisKind::Rotary)]).unwrap();
         s.dh = vec![
             DhJoint { a: 0.0, d: 0.0, alpha: 0.0, theta: 0.0, axis: Some("C".into()) },
             DhJoint { a: 100.0, d: 10.0, alpha: 90.0, theta: 0.0, axis: Some("Z".into()) },

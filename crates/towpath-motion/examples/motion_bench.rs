@@ -87,6 +87,15 @@ impl Lcg {
     }
 }
 
+/// CPU time of this process so far (all threads), seconds, from /proc (0 where unavailable):
+/// on a machine shared with other work it shows what the run itself cost.
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let fields: Vec<&str> = stat.rsplit(')').next().unwrap_or("").split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    (ticks(11) + ticks(12)) / 100.0
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -119,22 +128,21 @@ fn main() {
     };
     let pairs: Vec<(Vec<f64>, Vec<f64>)> = (0..count).map(|_| (end(), end())).collect();
     println!("mold: {} triangles; {} transits; {runs} runs", tris.len(), pairs.len());
-    let (mut build, mut check, mut plan) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut build, mut check, mut plan, mut cpu) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut summary = String::new();
     for _ in 0..runs {
         // The caller holds the meshes; building the cell from them is timed.
         let input = tris.clone();
-        let t0 = Instant::now();
+        let (t0, c0) = (Instant::now(), cpu_seconds());
         let cell = Arc::new(Cell::from_triangles(input));
-        let t1 = Instant::now();
-        eprintln!("built in {:?}", t1 - t0);
+        let (t1, c1) = (Instant::now(), cpu_seconds());
         let checker = Checker::new(cell, rig.clone(), CheckOptions::default());
         let checks = on_two_threads(&pairs, |(a, b)| checker.check(a, b, Contact::None));
-        let t2 = Instant::now();
-        eprintln!("checked in {:?}", t2 - t1);
+        let (t2, c2) = (Instant::now(), cpu_seconds());
         let planner = Planner::new(checker.clone(), PlanOptions::default()).expect("planner");
         let plans = on_two_threads(&pairs, |(a, b)| planner.plan(a, b));
-        let t3 = Instant::now();
+        let (t3, c3) = (Instant::now(), cpu_seconds());
+        cpu.push((c1 - c0, c2 - c1, c3 - c2));
         build.push((t1 - t0).as_secs_f64());
         check.push((t2 - t1).as_secs_f64());
         plan.push((t3 - t2).as_secs_f64());
@@ -151,8 +159,12 @@ fn main() {
     }
     println!("{summary}");
     let (b, c, p) = (median(build), median(check), median(plan));
-    println!("median of {runs} runs, 2 threads:");
-    println!("  build cell (BVH)            {:>8.3} s", b);
-    println!("  check 10,000 straight moves {:>8.3} s   (with build: {:.3} s)", c, b + c);
-    println!("  plan 10,000 transits        {:>8.3} s   (with build: {:.3} s)", p, b + p);
+    let cb = median(cpu.iter().map(|x| x.0).collect());
+    let cc = median(cpu.iter().map(|x| x.1).collect());
+    let cp = median(cpu.iter().map(|x| x.2).collect());
+    let n = pairs.len();
+    println!("medians of {runs} runs, 2 threads (wall s | CPU s of this process, both threads):");
+    println!("  build cell (BVH)        {b:>7.3} | {cb:>7.3}");
+    println!("  check {n} straight moves {c:>7.3} | {cc:>7.3}   with build: {:.3} | {:.3}", b + c, cb + cc);
+    println!("  plan {n} transits        {p:>7.3} | {cp:>7.3}   with build: {:.3} | {:.3}", b + p, cb + cp);
 }

@@ -281,7 +281,12 @@ impl Cell {
     /// at a near-constant distance from a dense mesh.
     pub fn segment_min(&self, p: DVec3, q: DVec3, cap: f64, slack: f64) -> f64 {
         let (pa, d) = (arr3(p), arr3(q - p));
-        self.best_first(cap, slack, |lo, hi| segment_box_dist(pa, d, lo, hi, [0.0; 3]), |t| segment_triangle_dist(p, q, t))
+        self.best_first(
+            cap,
+            slack,
+            |lo, hi| segment_box_dist(pa, d, lo, hi, [0.0; 3]),
+            |t| segment_triangle_dist(p, q, t),
+        )
     }
 
     /// [`Cell::quad_distance`] found best first, within `slack` above the truth like

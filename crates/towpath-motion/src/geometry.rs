@@ -229,9 +229,8 @@ mod tests {
             x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (x >> 11) as f64 / (1u64 << 53) as f64 * 10.0 - 5.0
         };
-        let point_box = |q: [f64; 3]| {
-            (0..3).map(|k| (lo[k] - q[k]).max(q[k] - hi[k]).max(0.0).powi(2)).sum::<f64>().sqrt()
-        };
+        let point_box =
+            |q: [f64; 3]| (0..3).map(|k| (lo[k] - q[k]).max(q[k] - hi[k]).max(0.0).powi(2)).sum::<f64>().sqrt();
         for _ in 0..300 {
             let (p, d) = ([r(), r(), r()], [r(), r(), r()]);
             let g = segment_box_dist(p, d, lo, hi, [0.0; 3]);

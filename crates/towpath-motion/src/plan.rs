@@ -96,12 +96,10 @@ impl Planner {
             LiftRule::Auto | LiftRule::ToolAxis => match xyz[2] {
                 Some(axis) if !rig.has_chain() => Lift::Axis { axis, sign: 1.0 },
                 _ if opts.lift == LiftRule::Auto => Lift::None("the machine has no Z axis to lift along"),
-                _ => {
-                    return Err(PlanError::NoLift(
-                        "lifting along the tool axis needs a machine whose X/Y/Z axes are the tool point, with a Z axis"
-                            .into(),
-                    ))
-                }
+                _ => return Err(PlanError::NoLift(
+                    "lifting along the tool axis needs a machine whose X/Y/Z axes are the tool point, with a Z axis"
+                        .into(),
+                )),
             },
             LiftRule::Radial => {
                 if rig.mandrel().is_none() || rig.has_chain() {
@@ -174,7 +172,9 @@ impl Planner {
                 let perp = v - k * v.dot(k);
                 let r = perp.length();
                 if !(r > 1e-9) {
-                    return Err(PlanError::NoLift("the tool point is on the mandrel axis, which has no radial direction".into()));
+                    return Err(PlanError::NoLift(
+                        "the tool point is on the mandrel axis, which has no radial direction".into(),
+                    ));
                 }
                 let shift = perp * ((level - r) / r);
                 let xyz = self.checker.rig().xyz_axes();

@@ -21,6 +21,10 @@ pub struct Pose {
     pub top: DVec3,
 }
 
+/// One joint of a DH chain as the bend bound needs it: |a|, the fixed |d|, and the driving
+/// axis with whether it is linear.
+type ChainJoint = (f64, f64, Option<(usize, bool)>);
+
 /// A machine with its kinematics and optional head model.
 #[derive(Clone, Debug)]
 pub struct Rig {
@@ -29,9 +33,8 @@ pub struct Rig {
     head: Option<Head>,
     /// The mandrel: (axis index, point on its axis, unit direction), if any.
     mandrel: Option<(usize, DVec3, DVec3)>,
-    /// For machines with a DH chain: per joint (|a|, fixed |d|, driving axis and whether it is
-    /// linear); and |tool_offset|.
-    chain: Option<(Vec<(f64, f64, Option<(usize, bool)>)>, f64)>,
+    /// For machines with a DH chain: its joints and |tool_offset|.
+    chain: Option<(Vec<ChainJoint>, f64)>,
     /// Indices of the X, Y, Z linear axes (machines without a chain).
     xyz: [Option<usize>; 3],
 }

@@ -162,14 +162,18 @@ fn reference(rig: &Rig, tris: &[[DVec3; 3]], from: &[f64], to: &[f64], n: usize)
         .collect();
     let (mut lower, mut upper) = (f64::INFINITY, f64::INFINITY);
     for k in 0..n {
-        let d = tris.iter().map(|t| ref_segment_triangle(poses[k].tool, poses[k + 1].tool, t)).fold(f64::INFINITY, f64::min);
+        let d = tris
+            .iter()
+            .map(|t| ref_segment_triangle(poses[k].tool, poses[k + 1].tool, t))
+            .fold(f64::INFINITY, f64::min);
         lower = lower.min(d - dev);
         upper = upper.min(d + dev);
     }
     if let Some(h) = rig.head() {
         for k in 0..=n {
             let p = &poses[k];
-            let d = tris.iter().map(|t| ref_segment_triangle(p.bottom, p.top, t)).fold(f64::INFINITY, f64::min) - h.radius;
+            let d =
+                tris.iter().map(|t| ref_segment_triangle(p.bottom, p.top, t)).fold(f64::INFINITY, f64::min) - h.radius;
             let step = if k < n {
                 (poses[k + 1].bottom - p.bottom).length().max((poses[k + 1].top - p.top).length())
             } else {
@@ -277,10 +281,9 @@ fn arm_moves_match_brute_force() {
 fn bend_bound_holds_on_sampled_paths() {
     let head = Some(Head { radius: 10.0, bottom: 12.0, top: 60.0 });
     let mut rng = Pcg64::seed_from_u64(5);
-    for (text, range) in [
-        (MANDREL, [(0.0, 300.0), (90.0, 200.0), (-180.0, 180.0)]),
-        (ARM, [(-90.0, 90.0), (-90.0, 90.0), (0.0, 150.0)]),
-    ] {
+    for (text, range) in
+        [(MANDREL, [(0.0, 300.0), (90.0, 200.0), (-180.0, 180.0)]), (ARM, [(-90.0, 90.0), (-90.0, 90.0), (0.0, 150.0)])]
+    {
         let rig = Rig::new(&machine(text), head).unwrap();
         for _ in 0..50 {
             let mut s = || range.iter().map(|&(a, b)| rng.gen_range(a..b)).collect::<Vec<f64>>();
@@ -310,7 +313,13 @@ fn bend_bound_holds_on_sampled_paths() {
 
 /// A box as 12 triangles.
 fn cuboid(lo: DVec3, hi: DVec3) -> Vec<[DVec3; 3]> {
-    let c = |i: usize| v(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z });
+    let c = |i: usize| {
+        v(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
     let faces = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]];
     faces.iter().flat_map(|f| [[c(f[0]), c(f[1]), c(f[2])], [c(f[0]), c(f[2]), c(f[3])]]).collect()
 }
@@ -384,7 +393,15 @@ fn limits_are_never_exceeded_including_reversed_headings() {
         let mut s = || {
             let c: f64 = rng.gen_range(-20.0..20.0);
             // A reversed course's heading: turned by 180°, the way that stays within ±200.
-            let c = if rng.gen_bool(0.5) { if c + 180.0 <= 200.0 { c + 180.0 } else { c - 180.0 } } else { c };
+            let c = if rng.gen_bool(0.5) {
+                if c + 180.0 <= 200.0 {
+                    c + 180.0
+                } else {
+                    c - 180.0
+                }
+            } else {
+                c
+            };
             // Off the flange (x 480..520), 10 to 40 mm over the plate.
             let x = if rng.gen_bool(0.5) { rng.gen_range(0.0..470.0) } else { rng.gen_range(530.0..1000.0) };
             vec![x, rng.gen_range(-200.0..200.0), rng.gen_range(10.0..40.0), c]
@@ -421,7 +438,9 @@ fn mandrel_with_flange(r: f64, rf: f64, n: usize) -> Vec<[DVec3; 3]> {
     };
     let mut t = Vec::new();
     for k in 0..n {
-        for (x0, x1, r0, r1) in [(0.0, 1000.0, r, r), (500.0, 500.0, r, rf), (510.0, 510.0, r, rf), (500.0, 510.0, rf, rf)] {
+        for (x0, x1, r0, r1) in
+            [(0.0, 1000.0, r, r), (500.0, 500.0, r, rf), (510.0, 510.0, r, rf), (500.0, 510.0, rf, rf)]
+        {
             let (a, b, c, d) = (at(x0, r0, k), at(x1, r1, k), at(x1, r1, k + 1), at(x0, r0, k + 1));
             t.push([a, b, c]);
             t.push([a, c, d]);
@@ -434,14 +453,18 @@ fn mandrel_with_flange(r: f64, rf: f64, n: usize) -> Vec<[DVec3; 3]> {
 fn around_a_mandrel_the_lift_is_radial() {
     let rig = Arc::new(Rig::new(&machine(MANDREL), None).unwrap());
     // 256 facets: the facets' chords lie within 140·(1 − cos(π/256)) ≈ 0.011 mm of the circle.
-    let checker = Checker::new(Arc::new(Cell::from_triangles(mandrel_with_flange(100.0, 140.0, 256))), rig, CheckOptions::default());
+    let checker = Checker::new(
+        Arc::new(Cell::from_triangles(mandrel_with_flange(100.0, 140.0, 256))),
+        rig,
+        CheckOptions::default(),
+    );
     let p = Planner::new(checker, PlanOptions::default()).unwrap();
     // From one course's exit at radius 125 to the next course's entry across the flange, the
     // mandrel turning by 90°: the tool must pass at least 145 from the axis.
     let (a, b) = ([300.0, 125.0, 0.0], [700.0, 125.0, 90.0]);
     let t = p.plan(&a, &b).unwrap();
     let level = t.level.unwrap();
-    assert!(level >= 145.0 - 0.01 && level <= 146.0 + 0.01, "radius {level}");
+    assert!((145.0 - 0.01..=146.0 + 0.01).contains(&level), "radius {level}");
     assert_eq!(t.waypoints[0], vec![300.0, level, 0.0]);
     assert_eq!(t.waypoints[1], vec![700.0, level, 90.0]);
     // On one side of the flange, turning the mandrel at radius 125 is clear: straight.
@@ -451,7 +474,11 @@ fn around_a_mandrel_the_lift_is_radial() {
     let mut tris = mandrel_with_flange(100.0, 140.0, 64);
     tris.extend((0..64).map(|k| {
         let a = |k: usize| std::f64::consts::TAU * k as f64 / 64.0;
-        [v(600.0, 0.0, 0.0), v(600.0, 100.0 * a(k).cos(), 100.0 * a(k).sin()), v(600.0, 100.0 * a(k + 1).cos(), 100.0 * a(k + 1).sin())]
+        [
+            v(600.0, 0.0, 0.0),
+            v(600.0, 100.0 * a(k).cos(), 100.0 * a(k).sin()),
+            v(600.0, 100.0 * a(k + 1).cos(), 100.0 * a(k + 1).sin()),
+        ]
     }));
     let rig = Arc::new(Rig::new(&machine(MANDREL), None).unwrap());
     let checker = Checker::new(Arc::new(Cell::from_triangles(tris)), rig, CheckOptions::default());
@@ -555,21 +582,31 @@ fn degenerate_setups_are_refused() {
     check_states(&rig, [&ok[..]]).unwrap();
     let e = check_states(&rig, [&ok[..], &bad[..]]).unwrap_err();
     assert!(matches!(&e, SetupError::OutsideLimits { axis, value, .. } if axis == "Y" && *value == 600.0), "{e}");
-    assert!(matches!(check_states(&rig, [&[0.0, 0.0][..]]).unwrap_err(), SetupError::WrongDimension { got: 2, expected: 4 }));
+    assert!(matches!(
+        check_states(&rig, [&[0.0, 0.0][..]]).unwrap_err(),
+        SetupError::WrongDimension { got: 2, expected: 4 }
+    ));
     // A head reaching below the tool point; a machine without kinematics.
     let e = Rig::new(&machine(GANTRY), Some(Head { radius: 30.0, bottom: 10.0, top: 50.0 })).unwrap_err();
     assert!(e.to_string().starts_with("head.bottom"), "{e}");
     let none = Machine::from_toml_str("name = \"r\"\n[[axis]]\nlabel = \"A\"\nkind = \"rotary\"\n").unwrap();
     assert_eq!(Rig::new(&none, None).unwrap_err(), SetupError::NoKinematics);
     // Meshes with bad coordinates.
-    let soup = Soup { positions: vec![v(0.0, 0.0, 0.0), v(f64::NAN, 0.0, 0.0), v(0.0, 1.0, 0.0)], triangles: vec![[0, 1, 2]] };
+    let soup =
+        Soup { positions: vec![v(0.0, 0.0, 0.0), v(f64::NAN, 0.0, 0.0), v(0.0, 1.0, 0.0)], triangles: vec![[0, 1, 2]] };
     let e = Cell::from_soups(&[Soup::default(), soup]).unwrap_err();
     assert!(e.to_string().starts_with("obstacle mesh 2: "), "{e}");
     // A DH chain cannot lift by itself, nor along a rotary axis.
     let arm = Arc::new(Rig::new(&machine(ARM), None).unwrap());
     let checker = Checker::new(Arc::new(Cell::empty()), arm, CheckOptions::default());
-    assert!(matches!(Planner::new(checker.clone(), PlanOptions { lift: LiftRule::Axis(0), step: 1.0 }), Err(PlanError::NoLift(_))));
-    assert!(matches!(Planner::new(checker.clone(), PlanOptions { lift: LiftRule::Radial, step: 1.0 }), Err(PlanError::NoLift(_))));
+    assert!(matches!(
+        Planner::new(checker.clone(), PlanOptions { lift: LiftRule::Axis(0), step: 1.0 }),
+        Err(PlanError::NoLift(_))
+    ));
+    assert!(matches!(
+        Planner::new(checker.clone(), PlanOptions { lift: LiftRule::Radial, step: 1.0 }),
+        Err(PlanError::NoLift(_))
+    ));
     // ... but along its slide (which moves the tool along the tool axis).
     Planner::new(checker, PlanOptions { lift: LiftRule::Axis(2), step: 1.0 }).unwrap();
 }
