@@ -610,3 +610,25 @@ fn degenerate_setups_are_refused() {
     // ... but along its slide (which moves the tool along the tool axis).
     Planner::new(checker, PlanOptions { lift: LiftRule::Axis(2), step: 1.0 }).unwrap();
 }
+
+/// A cell large enough to be built as two hierarchies answers like brute force.
+#[test]
+fn large_cells_in_two_halves_answer_exactly() {
+    let mut rng = Pcg64::seed_from_u64(9);
+    let tris: Vec<[DVec3; 3]> = (0..120_000)
+        .map(|_| {
+            let c = v(rng.gen_range(0.0..1000.0), rng.gen_range(0.0..1000.0), rng.gen_range(0.0..20.0));
+            [0, 1, 2].map(|_| c + v(rng.gen_range(-2.0..2.0), rng.gen_range(-2.0..2.0), rng.gen_range(-2.0..2.0)))
+        })
+        .collect();
+    let cell = Cell::from_triangles(tris.clone());
+    for _ in 0..3 {
+        let p = v(rng.gen_range(0.0..1000.0), rng.gen_range(0.0..1000.0), rng.gen_range(20.0..40.0));
+        let q = v(rng.gen_range(0.0..1000.0), rng.gen_range(0.0..1000.0), rng.gen_range(20.0..40.0));
+        let brute = tris.iter().map(|t| ref_segment_triangle(p, q, t)).fold(f64::INFINITY, f64::min);
+        let exact = cell.segment_distance(p, q, 100.0, -1.0);
+        let best_first = cell.segment_min(p, q, 100.0, 0.001);
+        assert!((exact - brute).abs() < 1e-6, "{exact} {brute}");
+        assert!(best_first >= brute - 1e-6 && best_first <= brute + 0.001 + 1e-6, "{best_first} {brute}");
+    }
+}
