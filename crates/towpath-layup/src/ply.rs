@@ -319,16 +319,34 @@ impl Planner<'_> {
         self.spec.tow_width * self.spec.tows as f64
     }
 
+    /// Walk options of centreline traces: up to the longest course, in steps of at most half a
+    /// course width (triangles larger than that are crossed in several steps).
+    fn course_walk(&self) -> WalkOptions {
+        WalkOptions { max_step: 0.5 * self.width(), ..WalkOptions::up_to(self.max_len) }
+    }
+
     fn key(&self, p: DVec3) -> [i64; 3] {
         let f = p / self.width();
         [f.x.floor() as i64, f.y.floor() as i64, f.z.floor() as i64]
     }
 
+    /// Remembers a course's centreline at points at most a tenth of a course width apart (long
+    /// segments, from large triangles, are filled in).
     fn remember(&mut self, pts: &[PathPoint], lateral: i32) {
+        let gap = 0.1 * self.width();
         let mut last: Option<DVec3> = None;
         for q in pts {
-            if last.is_some_and(|l| l.distance(q.p) < 0.1 * self.width()) {
-                continue;
+            if let Some(l) = last {
+                let d = l.distance(q.p);
+                if d < gap {
+                    continue;
+                }
+                let k = (d / gap).floor() as usize;
+                for j in 1..k {
+                    let x = l.lerp(q.p, j as f64 / k as f64);
+                    let key = self.key(x);
+                    self.grid.entry(key).or_default().push((x, lateral));
+                }
             }
             last = Some(q.p);
             let k = self.key(q.p);
@@ -372,19 +390,21 @@ impl Planner<'_> {
     /// closed once instead of wrapping again.
     fn trace(&self, start: Located, d0: DVec3, steer: Steering<'_>) -> Vec<PathPoint> {
         let w = self.width();
-        let opts = WalkOptions::up_to(self.max_len);
+        let opts = self.course_walk();
         let d_start = match steer {
             Steering::Field(f) => f.direction(start.p, start.n).map(|v| if v.dot(d0) < 0.0 { -v } else { v }),
             Steering::Geodesic => tangent(d0, start.n),
         };
         let Some(d_start) = d_start else { return Vec::new() };
         let mut closed = false;
-        let mut last = start.p;
+        let (mut last, mut last_s) = (start.p, 0.0);
         let (mut fwd, _) = walk(self.mesh, start, d_start, steer, &opts, |q| {
             if self.outside_far(q.p, q.n) {
                 return true;
             }
-            // Back at the start (a hoop): the step from the previous point passes the start.
+            // Back at the start (a hoop): a step from more than a course width along the path
+            // passes the start. (The first step, which leaves the start, does not count, however
+            // long it is: on a coarse mesh it may cross the whole ply.)
             let seg = q.p - last;
             let t = if seg.length_squared() > 0.0 {
                 ((start.p - last).dot(seg) / seg.length_squared()).clamp(0.0, 1.0)
@@ -392,8 +412,9 @@ impl Planner<'_> {
                 0.0
             };
             let near = (last + seg * t).distance(start.p);
-            last = q.p;
-            if q.s > 2.0 * w && near < 0.02 * w {
+            let from = last_s;
+            (last, last_s) = (q.p, q.s);
+            if from > w && q.s > 2.0 * w && near < 0.02 * w {
                 closed = true;
                 return true;
             }
@@ -590,7 +611,7 @@ impl Planner<'_> {
             return Next::Course(all);
         }
         // Extend both ends geodesically until leaving the ply or the mesh.
-        let opts = WalkOptions::up_to(self.max_len);
+        let opts = self.course_walk();
         let ext = |q: &PathPoint, dir: DVec3| -> Vec<PathPoint> {
             let Some(loc) = crate::course::locate(self.mesh, q.p, q.face) else { return Vec::new() };
             walk(self.mesh, loc, dir, Steering::Geodesic, &opts, |x| self.outside_far(x.p, x.n)).0

@@ -76,6 +76,17 @@ pub fn course_figures(c: &Course, field: &dyn DirectionField, spec: &PlySpec) ->
     let h = curvature_window(spec);
     let mut q = CourseQuality::default();
     let (mut j, mut k) = (0usize, 0usize);
+    // Arc-length range of the run of on-surface (or run-out) points containing point i.
+    let on_at = |x: usize| c.on_surface.get(x).copied().unwrap_or(true);
+    let mut runs: Vec<(f64, f64)> = Vec::with_capacity(pts.len());
+    let mut lo = 0;
+    for i in 0..pts.len() {
+        if i + 1 == pts.len() || on_at(i + 1) != on_at(i) {
+            runs.extend(std::iter::repeat_n((pts[lo].s, pts[i].s), i + 1 - lo));
+            lo = i + 1;
+        }
+    }
+    let run_bounds = |i: usize| runs.get(i).copied().unwrap_or((0.0, 0.0));
     for (i, p) in pts.iter().enumerate() {
         let dev = field.direction(p.p, p.n).map_or(0.0, |v| v.dot(p.d).abs().clamp(0.0, 1.0).acos().to_degrees());
         q.angle_deviation_deg.push(dev);
@@ -92,7 +103,20 @@ pub fn course_figures(c: &Course, field: &dyn DirectionField, spec: &PlySpec) ->
         }
         let (a, b) = (&pts[j], &pts[k]);
         let ds = b.s - a.s;
-        let kappa = if ds > 1e-9 { (b.d - a.d).dot(p.n.cross(p.d)) / ds } else { 0.0 };
+        let kappa = if ds >= 0.5 * h {
+            (b.d - a.d).dot(p.n.cross(p.d)) / ds
+        } else {
+            // Points sparser than the window (large triangles crossed in few steps): directions
+            // interpolated at the window's ends, within the same run of on- or off-surface points.
+            let (lo, hi) = run_bounds(i);
+            let (sa, sb) = ((p.s - h).max(lo), (p.s + h).min(hi));
+            if sb - sa > 1e-9 {
+                let (da, db) = (crate::course::frame_at(pts, sa).2, crate::course::frame_at(pts, sb).2);
+                (db - da).dot(p.n.cross(p.d)) / (sb - sa)
+            } else {
+                0.0
+            }
+        };
         q.geodesic_curvature.push(kappa);
         q.steering_radius.push((kappa.abs() > 1e-9).then(|| 1.0 / kappa.abs()));
     }
@@ -282,7 +306,7 @@ pub fn assess(
         let c = mesh.corners(f);
         c[0].distance(c[1]).max(c[1].distance(c[2])).max(c[2].distance(c[0]))
     };
-    let count_at = |h: f64| (0..nf as u32).map(|f| (edge_max(f) / h).ceil().clamp(1.0, 16.0).powi(2)).sum::<f64>();
+    let count_at = |h: f64| (0..nf as u32).map(|f| (edge_max(f) / h).ceil().clamp(1.0, 64.0).powi(2)).sum::<f64>();
     let mut stride = 1usize;
     while count_at(h) > budget && h < 1e6 {
         h *= 1.5;
@@ -297,7 +321,7 @@ pub fn assess(
         .map(|&f| {
             let c = mesh.corners(f);
             let nf = mesh.face_normal(f);
-            let m = (edge_max(f) / h).ceil().clamp(1.0, 16.0) as usize;
+            let m = (edge_max(f) / h).ceil().clamp(1.0, 64.0) as usize;
             let a = mesh.face_area(f) / (m * m) as f64;
             let (mut area, mut covered) = (0.0, 0.0);
             for i in 0..m {
