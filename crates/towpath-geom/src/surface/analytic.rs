@@ -79,7 +79,11 @@ impl Analytic {
             if !x.is_finite() {
                 return Err(fail(format!("{k} = {v} is not finite")));
             }
-            keys.push((k.trim().to_ascii_lowercase(), x));
+            let k = k.trim().to_ascii_lowercase();
+            if keys.iter().any(|(n, _)| *n == k) {
+                return Err(fail(format!("{k} is given twice")));
+            }
+            keys.push((k, x));
         }
         let allowed: &[&str] = match kind {
             "plane" => &["a", "b"],
@@ -91,7 +95,7 @@ impl Analytic {
         if let Some((k, _)) = keys.iter().find(|(k, _)| !allowed.contains(&k.as_str())) {
             return Err(fail(format!("unknown key '{k}' for a {kind} (expected {})", allowed.join(", "))));
         }
-        let get = |k: &str| keys.iter().rev().find(|(n, _)| n == k).map(|&(_, v)| v);
+        let get = |k: &str| keys.iter().find(|(n, _)| n == k).map(|&(_, v)| v);
         let need = |k: &str| get(k).ok_or_else(|| fail(format!("missing {k}=")));
         let positive = |k: &str| -> Result<f64, ParseError> {
             let v = need(k)?;
@@ -277,6 +281,8 @@ mod tests {
         assert!(e.to_string().contains("not a number"), "{e}");
         assert!(Analytic::parse("cylinder:r=-1,l=2").is_err());
         assert!(Analytic::parse("cylinder:r=1,l=2,q=3").is_err());
+        let e = Analytic::parse("plane:a=100,b=50,A=200").unwrap_err();
+        assert!(e.to_string().contains("a is given twice"), "{e}");
     }
 
     #[test]
