@@ -210,7 +210,8 @@ fn spacing_to(mesh: &Mesh, c: &Course, near: &Nearest, s: f64, reach: f64) -> Op
     None
 }
 
-/// Assesses a ply.
+/// Assesses a ply: per-point angle and steering figures, gaps and overlaps between neighbours,
+/// coverage of the ply area.
 pub fn assess(
     mesh: &Mesh,
     field: &dyn DirectionField,
@@ -218,9 +219,18 @@ pub fn assess(
     spec: &PlySpec,
     courses: &[Course],
 ) -> PlyQuality {
-    let w = spec.tow_width * spec.tows as f64;
-    let nt = spec.tows;
     let mut pq = PlyQuality { min_steering_radius_limit: spec.min_steering_radius, ..PlyQuality::default() };
+    angles_and_steering(&mut pq, field, spec, courses);
+    gaps_and_overlaps(&mut pq, mesh, spec, courses);
+    let (area, covered) = coverage(mesh, region, spec, courses);
+    pq.ply_area = area;
+    pq.coverage_percent = covered;
+    pq
+}
+
+/// Angle deviation and steering figures of every course (per point and per ply), lengths.
+fn angles_and_steering(pq: &mut PlyQuality, field: &dyn DirectionField, spec: &PlySpec, courses: &[Course]) {
+    let nt = spec.tows;
     let mut angle_sum = 0.0;
     let mut angle_n = 0usize;
     for c in courses {
@@ -249,10 +259,15 @@ pub fn assess(
     if angle_n > 0 {
         pq.mean_angle_deviation_deg = angle_sum / angle_n as f64;
     }
-    // Gaps and overlaps between each course and its left neighbour, where both edge tows are laid:
-    // a geodesic walked from the course's centreline perpendicular to the fiber, to where it
-    // crosses the neighbour's centreline; the spacing minus one course width is the gap (+) or
-    // overlap (−). The last and first courses are tried as a pair too (closed surfaces).
+}
+
+/// Gaps and overlaps between each course and its left neighbour, where both edge tows are laid:
+/// a geodesic walked from the course's centreline perpendicular to the fiber, to where it
+/// crosses the neighbour's centreline; the spacing minus one course width is the gap (+) or
+/// overlap (−). The last and first courses are tried as a pair too (closed surfaces).
+fn gaps_and_overlaps(pq: &mut PlyQuality, mesh: &Mesh, spec: &PlySpec, courses: &[Course]) {
+    let w = spec.tow_width * spec.tows as f64;
+    let nt = spec.tows;
     let step = (0.1 * w).clamp(2.0, 10.0);
     let mut pairs: Vec<(usize, usize)> = (0..courses.len().saturating_sub(1)).map(|i| (i, i + 1)).collect();
     if courses.len() > 2 {
@@ -294,8 +309,11 @@ pub fn assess(
         }
         pq.courses[i].gap_to_left.extend(widths);
     }
-    // Coverage: area-weighted face-centroid samples inside the ply, each checked against the laid
-    // tows of the nearest course stations.
+}
+
+/// Coverage: area-weighted samples inside the ply, each checked against the laid tows of the
+/// nearest course stations. Returns the ply area and the covered share (%).
+fn coverage(mesh: &Mesh, region: &Region, spec: &PlySpec, courses: &[Course]) -> (f64, f64) {
     let laid = LaidMap::new(courses, Band { tow_width: spec.tow_width, tows: spec.tows });
     // Samples: every face split into m × m sub-triangles (m from the face size and a spacing of
     // half a tow width, within a budget), one sample at each sub-triangle's centroid.
@@ -352,7 +370,5 @@ pub fn assess(
         area += a;
         covered += c;
     }
-    pq.ply_area = area * stride as f64;
-    pq.coverage_percent = if area > 0.0 { 100.0 * covered / area } else { 0.0 };
-    pq
+    (area * stride as f64, if area > 0.0 { 100.0 * covered / area } else { 0.0 })
 }
