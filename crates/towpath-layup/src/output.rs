@@ -31,6 +31,8 @@ pub struct Meta {
     pub method: Method,
     /// Ply number in programs.
     pub ply_number: usize,
+    /// Units the surface and lengths were given in (every output is in millimetres).
+    pub input_units: crate::units::Units,
 }
 
 #[derive(Serialize)]

@@ -138,6 +138,26 @@ impl Analytic {
         })
     }
 
+    /// The same surface with every length multiplied by `f` (a change of units); angles kept.
+    pub fn scaled(&self, f: f64) -> Analytic {
+        match *self {
+            Analytic::Plane { a, b } => Analytic::Plane { a: a * f, b: b * f },
+            Analytic::Cylinder { r, l, a0, a1 } => Analytic::Cylinder { r: r * f, l: l * f, a0, a1 },
+            Analytic::Cone { r0, r1, l, a0, a1 } => Analytic::Cone { r0: r0 * f, r1: r1 * f, l: l * f, a0, a1 },
+            Analytic::Sphere { r, lat0, lat1 } => Analytic::Sphere { r: r * f, lat0, lat1 },
+        }
+    }
+
+    /// The largest length of the description (radius, side or length).
+    pub fn size(&self) -> f64 {
+        match *self {
+            Analytic::Plane { a, b } => a.max(b),
+            Analytic::Cylinder { r, l, .. } => r.max(l),
+            Analytic::Cone { r0, r1, l, .. } => r0.max(r1).max(l),
+            Analytic::Sphere { r, .. } => r,
+        }
+    }
+
     /// Whether u is periodic and the surface closes on itself (full tube, cone or sphere).
     pub fn is_closed_u(&self) -> bool {
         match *self {
