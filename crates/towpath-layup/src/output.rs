@@ -75,6 +75,7 @@ struct Summary<'a> {
     n1: usize,
     n2: usize,
     n_estimate: [usize; 2],
+    section_width: f64,
     seconds: f64,
     timings: crate::ply::Timings,
     #[serde(flatten)]
@@ -111,6 +112,7 @@ pub fn summary(ply: &Ply) -> serde_json::Value {
         n1: ply.n1,
         n2: ply.n2,
         n_estimate: ply.n_estimate,
+        section_width: ply.section_width,
         seconds: ply.seconds,
         timings: ply.timings,
         quality: quality_summary(&ply.quality),

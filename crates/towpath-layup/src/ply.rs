@@ -92,6 +92,9 @@ pub struct Ply {
     /// Seed 002 eq. 9 estimate ⌈max section length / course width⌉ on each side (left, right),
     /// from sections across the reference course.
     pub n_estimate: [usize; 2],
+    /// The ply's width across the fibers at the reference course (mm): the longest section on
+    /// the left plus the longest on the right.
+    pub section_width: f64,
     /// Quality figures.
     pub quality: PlyQuality,
     /// Time spent planning (s).
@@ -196,7 +199,16 @@ pub fn plan(
     let quality = quality::assess(mesh, field, region, spec, &courses);
     check_time(spec, courses.len())?;
     timings.quality = tp.elapsed().as_secs_f64();
-    Ok(Ply { courses, n1, n2, n_estimate: traced.n_estimate, quality, seconds: t0.elapsed().as_secs_f64(), timings })
+    Ok(Ply {
+        courses,
+        n1,
+        n2,
+        n_estimate: traced.n_estimate,
+        section_width: traced.section_width,
+        quality,
+        seconds: t0.elapsed().as_secs_f64(),
+        timings,
+    })
 }
 
 /// Fails with [`PlyError::TimeLimit`] once the spec's deadline has passed.
@@ -215,6 +227,7 @@ struct Traced {
     n1: usize,
     n2: usize,
     n_estimate: [usize; 2],
+    section_width: f64,
 }
 
 /// A centreline before trimming: (side, rank on the side, points, whether each is on the mesh).
@@ -257,7 +270,7 @@ impl Planner<'_> {
         self.remember(&reference, 0);
         let mut done = 1usize;
         progress(done);
-        let n_estimate = self.estimate(&reference);
+        let (n_estimate, section_width) = self.estimate(&reference);
         let mut sides: [Vec<Vec<PathPoint>>; 2] = [Vec::new(), Vec::new()];
         // Whether a side stopped because its next course would land on a course laid more than
         // two courses away from it: the surface closes on itself across the fibers (a helical
@@ -316,7 +329,7 @@ impl Planner<'_> {
         for (i, c) in left.into_iter().enumerate() {
             lines.push((1, i + 1, c));
         }
-        Ok(Traced { lines, closing, n1, n2, n_estimate })
+        Ok(Traced { lines, closing, n1, n2, n_estimate, section_width })
     }
 
     /// Run-outs, per-tow trimming and cropping of every centreline (independently, in
@@ -755,10 +768,11 @@ impl Planner<'_> {
     }
 
     /// Seed 002 eq. 9: the longest section across the reference course on each side, walked as a
-    /// geodesic perpendicular to the fiber until it leaves the ply, divided by the course width.
-    fn estimate(&self, reference: &[PathPoint]) -> [usize; 2] {
+    /// geodesic perpendicular to the fiber until it leaves the ply, divided by the course width;
+    /// and the two longest sections added (the ply's width across the fibers).
+    fn estimate(&self, reference: &[PathPoint]) -> ([usize; 2], f64) {
         let w = self.width();
-        let Some(len) = reference.last().map(|q| q.s) else { return [0, 0] };
+        let Some(len) = reference.last().map(|q| q.s) else { return ([0, 0], 0.0) };
         let mut best = [0.0f64; 2];
         let count = (len / w).ceil().max(1.0) as usize;
         for i in 0..=count {
@@ -783,7 +797,7 @@ impl Planner<'_> {
         }
         // The reference course covers half a width on each side.
         let count = |l: f64| ((l - 0.5 * w).max(0.0) / w - 1e-6).ceil().max(0.0) as usize;
-        [count(best[0]), count(best[1])]
+        ([count(best[0]), count(best[1])], best[0] + best[1])
     }
 }
 

@@ -266,11 +266,11 @@ pub enum Warning {
         /// Tow width (mm).
         mm: f64,
     },
-    /// One course is wider than the whole ply.
+    /// One course is wider than the whole ply across the fibers.
     CourseWiderThanPly {
         /// Course width (mm).
         course_mm: f64,
-        /// The ply's largest extent (bounding-box diagonal, mm).
+        /// The ply's width across the fibers at the reference course (mm).
         ply_mm: f64,
     },
     /// Laid tows cover little of the ply.
@@ -322,7 +322,7 @@ impl std::fmt::Display for Warning {
             ),
             Warning::CourseWiderThanPly { course_mm, ply_mm } => write!(
                 f,
-                "one course ({} mm) is wider than the whole ply ({} across)",
+                "one course ({} mm) is wider than the whole ply ({} across the fibers)",
                 sig(course_mm),
                 length(ply_mm)
             ),
@@ -598,7 +598,12 @@ pub fn run(mut request: LayupRequest, progress: Progress<'_>) -> Result<LayupRes
     let limits = request.limits;
     let f = request.units.mm();
     let tl = Instant::now();
-    let soup = request.soup()?;
+    let soup = match request.soup() {
+        Err(LayupError::Tessellation(TessellationError::TimeLimit)) => {
+            return Err(LayupError::TimeLimit("tessellating the surface"))
+        }
+        other => other?,
+    };
     if limits.past_deadline() {
         return Err(LayupError::TimeLimit("tessellating the surface"));
     }
@@ -719,8 +724,8 @@ fn warnings(request: &LayupRequest, ply: &Ply, size: f64, ply_size: f64, width: 
     if !(1.0..=305.0).contains(&tw) {
         out.push(Warning::TowWidth { mm: tw });
     }
-    if width > ply_size {
-        out.push(Warning::CourseWiderThanPly { course_mm: width, ply_mm: ply_size });
+    if width > ply.section_width.min(ply_size) {
+        out.push(Warning::CourseWiderThanPly { course_mm: width, ply_mm: ply.section_width.min(ply_size) });
     }
     let q = &ply.quality;
     if q.coverage_percent < 95.0 {

@@ -50,7 +50,7 @@ pub struct Args {
     #[arg(long)]
     pub orientations: Option<PathBuf>,
     /// Tow width, in --units unless it carries its own unit (`6.35`, `0.25in`, `6.35mm`).
-    #[arg(long, value_parser = parse_tow_width)]
+    #[arg(long, value_parser = parse_tow_width, allow_hyphen_values = true)]
     pub tow_width: (f64, Option<Units>),
     /// Tows per course.
     #[arg(long)]
