@@ -95,6 +95,9 @@ pub struct Ply {
     /// The ply's width across the fibers at the reference course (mm): the longest section on
     /// the left plus the longest on the right.
     pub section_width: f64,
+    /// Whether the surface closed on itself across the fibers (a ply round a tube): the
+    /// sections on both sides then run round the same surface.
+    pub wraps: bool,
     /// Quality figures.
     pub quality: PlyQuality,
     /// Time spent planning (s).
@@ -205,6 +208,7 @@ pub fn plan(
         n2,
         n_estimate: traced.n_estimate,
         section_width: traced.section_width,
+        wraps: traced.wraps,
         quality,
         seconds: t0.elapsed().as_secs_f64(),
         timings,
@@ -228,6 +232,7 @@ struct Traced {
     n2: usize,
     n_estimate: [usize; 2],
     section_width: f64,
+    wraps: bool,
 }
 
 /// A centreline before trimming: (side, rank on the side, points, whether each is on the mesh).
@@ -329,7 +334,7 @@ impl Planner<'_> {
         for (i, c) in left.into_iter().enumerate() {
             lines.push((1, i + 1, c));
         }
-        Ok(Traced { lines, closing, n1, n2, n_estimate, section_width })
+        Ok(Traced { lines, closing, n1, n2, n_estimate, section_width, wraps: blocked })
     }
 
     /// Run-outs, per-tow trimming and cropping of every centreline (independently, in

@@ -447,6 +447,12 @@ impl LayupRequest {
                 }
             }
         }
+        self.validate_limits()?;
+        self.validate_direction()?;
+        self.validate_points()
+    }
+
+    fn validate_limits(&self) -> Result<(), LayupError> {
         for (what, v) in [
             ("triangles", self.limits.max_triangles),
             ("courses", self.limits.max_courses),
@@ -456,6 +462,11 @@ impl LayupRequest {
                 return Err(LayupError::Limit(what));
             }
         }
+        Ok(())
+    }
+
+    /// The axis, guide curves or orientation samples.
+    fn validate_direction(&self) -> Result<(), LayupError> {
         match &self.direction {
             DirectionSource::Axis(a) => {
                 if !(a.is_finite() && a.length() > 0.0 && a.length().is_finite()) {
@@ -481,6 +492,12 @@ impl LayupRequest {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Boundary, start point and the surface's own coordinates: finite and within reach.
+    fn validate_points(&self) -> Result<(), LayupError> {
+        let f = self.units.mm();
         for p in self.boundary.iter().flatten() {
             self.near("boundary point", *p)?;
         }
@@ -737,7 +754,10 @@ fn warnings(request: &LayupRequest, ply: &Ply, size: f64, ply_size: f64, width: 
     if q.gap_area > 0.05 * q.ply_area {
         out.push(Warning::LargeGaps { gap_mm2: q.gap_area, ply_mm2: q.ply_area });
     }
-    let estimate = ply.n_estimate[0] + ply.n_estimate[1] + 1;
+    // Round a tube the sections on both sides run round the same surface: either side alone
+    // counts the courses.
+    let [left, right] = ply.n_estimate;
+    let estimate = if ply.wraps { left.max(right) + 1 } else { left + right + 1 };
     let courses = ply.courses.len();
     if courses.abs_diff(estimate) > 2 && (2 * courses < estimate || courses > 2 * estimate) {
         out.push(Warning::CourseCount { courses, estimate });

@@ -36,6 +36,8 @@ fn cylinder_helix_ply_with_gcode_and_csv() {
     assert_eq!(s["courses"], 14);
     assert!(s["coverage_percent"].as_f64().unwrap() > 99.5, "{s}");
     assert!(s["max_angle_deviation_deg"].as_f64().unwrap() < 0.05);
+    // Nothing looks wrong: no warning (the sections round the tube count its courses once).
+    assert_eq!(s["warnings"].as_array().map(Vec::len), Some(0), "{s}");
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(d.join("c.json")).unwrap()).unwrap();
     assert_eq!(doc["format"], "towpath-courses");
     assert_eq!(doc["courses"].as_array().unwrap().len(), 14);
