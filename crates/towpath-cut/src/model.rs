@@ -14,6 +14,9 @@ pub struct Piece {
     pub path: Path,
     /// Whether an open stroke may be drawn backwards (ignored for closed contours).
     pub reversible: bool,
+    /// Done exactly as drawn: not reversed, a closed contour not started elsewhere (G-code
+    /// pieces whose moves carry other axes, say).
+    pub fixed: bool,
 }
 
 /// What the ordering and the writers work on.

@@ -184,7 +184,7 @@ fn prepare(drawing: &Drawing, shapes: &Shapes, opts: &OrderOptions) -> Prepared 
     for (i, piece) in drawing.pieces.iter().enumerate() {
         let path = &piece.path;
         let mut cands = Vec::new();
-        if path.closed && !path.segs.is_empty() {
+        if path.closed && !path.segs.is_empty() && !piece.fixed {
             for place in entry_places(path, opts) {
                 let p = path.point(place);
                 let entry = match &opts.lead_in {
@@ -195,7 +195,7 @@ fn prepare(drawing: &Drawing, shapes: &Shapes, opts: &OrderOptions) -> Prepared 
             }
         } else {
             cands.push(Candidate { place: None, reversed: false, entry: path.start, exit: path.end() });
-            if opts.reverse && piece.reversible && path.start != path.end() {
+            if opts.reverse && piece.reversible && !piece.fixed && path.start != path.end() {
                 cands.push(Candidate { place: None, reversed: true, entry: path.end(), exit: path.start });
             }
         }
@@ -340,7 +340,7 @@ fn refine(drawing: &Drawing, shapes: &Shapes, prep: &Prepared, opts: &OrderOptio
         for k in 0..placements.len() {
             let piece = placements[k].piece;
             let src = &drawing.pieces[piece].path;
-            if !src.closed || src.segs.is_empty() {
+            if !src.closed || src.segs.is_empty() || drawing.pieces[piece].fixed {
                 continue;
             }
             let prev = if k == 0 { opts.start } else { Some(placements[k - 1].exit()) };

@@ -161,6 +161,9 @@ pub fn verify(drawing: &Drawing, done: &[Placement], rules: &Rules) -> Verificat
             continue;
         }
         pos[p.piece] = k;
+        if piece.fixed && p.path != piece.path {
+            v.geometry.push(format!("{}: must be done as drawn", piece.id));
+        }
         if let Err(e) = same_geometry(&piece.path, &p.path, p.reversed, rules.reverse && piece.reversible, rules.tolerance) {
             v.geometry.push(format!("{}: {e}", piece.id));
         }

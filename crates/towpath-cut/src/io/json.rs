@@ -184,7 +184,7 @@ pub fn read(text: &str, name: &str) -> Result<(Drawing, JsonSource), CutError> {
             }
         };
         let path = path_from(&p.points, &p.bulges, p.closed, &what)?;
-        d.pieces.push(Piece { id: p.id.clone(), operation: op, path, reversible: p.reversible });
+        d.pieces.push(Piece { id: p.id.clone(), operation: op, path, reversible: p.reversible, fixed: false });
         for a in &p.after {
             let Some(&j) = ids.get(a) else {
                 return Err(CutError::Input(format!("{what}: after names {a:?}, which is no piece's id")));

@@ -282,7 +282,7 @@ pub fn read(text: &str, name: &str, tol: f64) -> Result<(Drawing, SvgSource), Cu
         for (j, path) in subpaths.into_iter().enumerate() {
             let id = if j == 0 { base.clone() } else { format!("{base}-{}", j + 1) };
             piece_element.push((k, j));
-            drawing.pieces.push(Piece { id, operation: layer_op[&e.layer], path, reversible: true });
+            drawing.pieces.push(Piece { id, operation: layer_op[&e.layer], path, reversible: true, fixed: false });
         }
     }
     // Layer start tags, transforms, and content to keep.
