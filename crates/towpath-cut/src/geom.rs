@@ -328,6 +328,47 @@ impl Path {
     }
 }
 
+impl Path {
+    /// The place on the path closest to `p` (sampled within `tol`, then refined by golden
+    /// section on the best segment piece).
+    pub fn closest_place(&self, p: P2, tol: f64) -> Place {
+        let mut best = (f64::INFINITY, Place { seg: 0, t: 0.0 }, 2.0);
+        let mut tmp = Vec::new();
+        for (i, s) in self.segs.iter().enumerate() {
+            tmp.clear();
+            let from = self.seg_start(i);
+            seg_flatten(from, s, tol, &mut tmp);
+            let m = tmp.len().clamp(1, 256);
+            for j in 0..=m {
+                let t = j as f64 / m as f64;
+                let d = dist(p, seg_point(from, s, t));
+                if d < best.0 {
+                    best = (d, Place { seg: i, t }, m as f64);
+                }
+            }
+        }
+        let Some(s) = self.segs.get(best.1.seg) else { return best.1 };
+        let from = self.seg_start(best.1.seg);
+        let (mut lo, mut hi) = ((best.1.t - 1.0 / best.2).max(0.0), (best.1.t + 1.0 / best.2).min(1.0));
+        let g = 0.618_033_988_749_894_9;
+        for _ in 0..60 {
+            let a = hi - g * (hi - lo);
+            let b = lo + g * (hi - lo);
+            if dist(p, seg_point(from, s, a)) <= dist(p, seg_point(from, s, b)) {
+                hi = b;
+            } else {
+                lo = a;
+            }
+        }
+        let t = 0.5 * (lo + hi);
+        if dist(p, seg_point(from, s, t)) < best.0 {
+            Place { seg: best.1.seg, t }
+        } else {
+            best.1
+        }
+    }
+}
+
 /// The bounding box of points (an empty box of NaNs for none).
 pub fn bbox_of(points: &[P2]) -> BBox {
     let mut b = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
