@@ -10,7 +10,7 @@
 //!
 //! **Writing.** The header, tables and every entity that is not a piece are kept; the pieces
 //! follow in their new order. A piece done as drawn is written as its original entity (same
-//! handle, layer, colour); a reversed or restarted one as an LWPOLYLINE with bulges (exactly
+//! handle, layer, colour); a reversed or restarted one as an LWPOLYLINE (a 2D POLYLINE in R12 files) with bulges (exactly
 //! the same lines and arcs) carrying the original's layer, colour and line type. Lead-ins are
 //! LWPOLYLINEs on the piece's layer just before it.
 
@@ -219,6 +219,27 @@ fn kind(e: &dxf::entities::Entity) -> &'static str {
     }
 }
 
+/// A path as an LWPOLYLINE (R13 and later) or a 2D POLYLINE (R12, which has no LWPOLYLINE).
+fn polyline_entity(out: &mut dxf::Drawing, path: &Path, common: &dxf::entities::EntityCommon) -> dxf::entities::Entity {
+    if out.header.version >= dxf::enums::AcadVersion::R13 {
+        return lwpolyline(path, common);
+    }
+    let jp = crate::io::json::path_to(path);
+    let mut poly = dxf::entities::Polyline::default();
+    poly.flags = i32::from(path.closed);
+    for (i, p) in jp.points.iter().enumerate() {
+        let mut v = dxf::entities::Vertex::new(dxf::Point::new(p[0], p[1], 0.0));
+        v.bulge = jp.bulges.get(i).copied().unwrap_or(0.0);
+        poly.add_vertex(out, v);
+    }
+    let mut e = dxf::entities::Entity::new(dxf::entities::EntityType::Polyline(poly));
+    e.common.layer = common.layer.clone();
+    e.common.color = common.color.clone();
+    e.common.line_type_name = common.line_type_name.clone();
+    e.common.lineweight_enum_value = common.lineweight_enum_value;
+    e
+}
+
 fn lwpolyline(path: &Path, common: &dxf::entities::EntityCommon) -> dxf::entities::Entity {
     let jp = crate::io::json::path_to(path);
     let mut lw = dxf::entities::LwPolyline::default();
@@ -243,12 +264,14 @@ pub fn write(source: &DxfSource, _drawing: &Drawing, order: &[Placement]) -> Res
     for pl in order {
         let (Some(orig), Some(path)) = (source.entities.get(pl.piece), source.original.get(pl.piece)) else { continue };
         if let Some(l) = &pl.lead_in {
-            out.add_entity(lwpolyline(l, &orig.common));
+            let e = polyline_entity(&mut out, l, &orig.common);
+            out.add_entity(e);
         }
         if pl.path == *path {
             out.add_entity(orig.clone());
         } else {
-            out.add_entity(lwpolyline(&pl.path, &orig.common));
+            let e = polyline_entity(&mut out, &pl.path, &orig.common);
+            out.add_entity(e);
         }
     }
     let mut buf = Vec::new();

@@ -227,13 +227,17 @@ pub fn read(text: &str, name: &str) -> Result<(Drawing, GcodeSource), CutError> 
     let mut blocks = Vec::new();
     // Split points between consecutive runs: the first X/Y rapid in the gap (excluded), else
     // just after the last break in the gap.
-    let split = |from: usize, to: usize| -> (usize, usize) {
-        if let Some(k) = (from..to).find(|&k| matches!(kinds[k], Kind::RapidXy)) {
-            return (k, k + 1);
+    let split = |from: usize, to: usize| -> (usize, usize, Vec<usize>) {
+        let first = (from..to).find(|&k| matches!(kinds[k], Kind::RapidXy));
+        let last = (from..to).rev().find(|&k| matches!(kinds[k], Kind::RapidXy));
+        if let (Some(f), Some(l)) = (first, last) {
+            // Lines between the rapids other than rapids travel with the piece before.
+            let middle = (f + 1..l).filter(|&k| !matches!(kinds[k], Kind::RapidXy)).collect();
+            return (f, l + 1, middle);
         }
         match (from..to).rev().find(|&k| matches!(kinds[k], Kind::Break)) {
-            Some(k) => (k + 1, k + 1),
-            None => (from, from),
+            Some(k) => (k + 1, k + 1, Vec::new()),
+            None => (from, from, Vec::new()),
         }
     };
     let header_end = match runs.first() {
@@ -250,11 +254,11 @@ pub fn read(text: &str, name: &str) -> Result<(Drawing, GcodeSource), CutError> 
     let mut prefix_start = header_end.1;
     let mut footer = Vec::new();
     for (n, &(a, b)) in runs.iter().enumerate() {
-        let (suffix_end, next_prefix) = match runs.get(n + 1) {
+        let (suffix_end, next_prefix, middle) = match runs.get(n + 1) {
             Some(&(na, _)) => split(b + 1, na),
             None => match (b + 1..lines.len()).find(|&k| matches!(kinds[k], Kind::RapidXy)) {
-                Some(k) => (k, k),
-                None => (lines.len(), lines.len()),
+                Some(k) => (k, k, Vec::new()),
+                None => (lines.len(), lines.len(), Vec::new()),
             },
         };
         if n + 1 == runs.len() {
@@ -288,7 +292,11 @@ pub fn read(text: &str, name: &str) -> Result<(Drawing, GcodeSource), CutError> 
         blocks.push(Block {
             prefix: owned(prefix_start.min(a), a),
             motion: owned(a, b + 1),
-            suffix: owned(b + 1, suffix_end.max(b + 1)),
+            suffix: {
+                let mut v = owned(b + 1, suffix_end.max(b + 1));
+                v.extend(middle.iter().map(|&k| lines[k].to_string()));
+                v
+            },
             motion_word: (!has_word).then(|| first_mode.word().to_string()),
             feed: if *has_f { None } else { feed_before.clone() },
             prefix_mode,
