@@ -405,3 +405,155 @@ fn refine(drawing: &Drawing, shapes: &Shapes, prep: &Prepared, opts: &OrderOptio
         }
     }
 }
+
+/// Chains of open strokes whose ends meet within `tol` (same operation, reversible, not in the
+/// explicit hierarchy): each chain is `(piece, reversed)` in drawing order; lone strokes are
+/// not listed.
+pub fn merge_chains(drawing: &Drawing, tol: f64) -> Vec<Vec<(usize, bool)>> {
+    use std::collections::HashMap;
+    let n = drawing.pieces.len();
+    let mut in_hierarchy = vec![false; n];
+    for &(a, b) in &drawing.hierarchy {
+        if a < n && b < n {
+            in_hierarchy[a] = true;
+            in_hierarchy[b] = true;
+        }
+    }
+    let ok: Vec<bool> = (0..n)
+        .map(|i| {
+            let p = &drawing.pieces[i];
+            !p.path.closed && p.reversible && !p.fixed && !in_hierarchy[i] && !p.path.segs.is_empty()
+        })
+        .collect();
+    let cell = tol.max(1e-12);
+    let key = |p: P2| ((p[0] / cell).floor() as i64, (p[1] / cell).floor() as i64);
+    let mut grid: HashMap<(i64, i64), Vec<(usize, bool)>> = HashMap::new();
+    for i in (0..n).filter(|&i| ok[i]) {
+        let p = &drawing.pieces[i].path;
+        grid.entry(key(p.start)).or_default().push((i, false));
+        grid.entry(key(p.end())).or_default().push((i, true));
+    }
+    let mut used = vec![false; n];
+    // The unused stroke with an end within `tol` of `at`: (piece, whether it must be reversed).
+    let find = |at: P2, op: usize, used: &[bool]| -> Option<(usize, bool)> {
+        let (kx, ky) = key(at);
+        let mut best: Option<(f64, usize, bool)> = None;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for &(j, at_end) in grid.get(&(kx + dx, ky + dy)).into_iter().flatten() {
+                    if used[j] || drawing.pieces[j].operation != op {
+                        continue;
+                    }
+                    let p = &drawing.pieces[j].path;
+                    let d = dist(at, if at_end { p.end() } else { p.start });
+                    if d <= tol && best.is_none_or(|b| d < b.0 || (d == b.0 && j < b.1)) {
+                        best = Some((d, j, at_end));
+                    }
+                }
+            }
+        }
+        best.map(|b| (b.1, b.2))
+    };
+    let mut chains = Vec::new();
+    for i in 0..n {
+        if !ok[i] || used[i] {
+            continue;
+        }
+        used[i] = true;
+        let op = drawing.pieces[i].operation;
+        let mut chain = std::collections::VecDeque::from([(i, false)]);
+        // forward from the end
+        let mut at = drawing.pieces[i].path.end();
+        while let Some((j, rev)) = find(at, op, &used) {
+            used[j] = true;
+            let p = &drawing.pieces[j].path;
+            at = if rev { p.start } else { p.end() };
+            chain.push_back((j, rev));
+        }
+        // backward from the start
+        let mut at = drawing.pieces[i].path.start;
+        while let Some((j, at_end)) = find(at, op, &used) {
+            used[j] = true;
+            let p = &drawing.pieces[j].path;
+            // joined at its end: it runs forwards into `at`; at its start: reversed.
+            at = if at_end { p.start } else { p.end() };
+            chain.push_front((j, !at_end));
+        }
+        if chain.len() > 1 {
+            chains.push(chain.into_iter().collect());
+        }
+    }
+    chains
+}
+
+/// [`order`] with strokes whose ends meet within `tol` joined into one task each (so they are
+/// drawn one after the other without lifting); the answer still lists every piece on its own.
+pub fn order_merged(drawing: &Drawing, opts: &OrderOptions, tol: f64) -> Result<OrderReport, CutError> {
+    let chains = merge_chains(drawing, tol);
+    if chains.is_empty() {
+        return order(drawing, opts);
+    }
+    let n = drawing.pieces.len();
+    let mut chained = vec![false; n];
+    for c in &chains {
+        for &(i, _) in c {
+            chained[i] = true;
+        }
+    }
+    // The merged drawing: lone pieces, then one open piece per chain.
+    let mut merged = Drawing { operations: drawing.operations.clone(), pieces: Vec::new(), hierarchy: Vec::new() };
+    let mut origin: Vec<Result<usize, usize>> = Vec::new(); // Ok(piece) or Err(chain)
+    let mut new_index = vec![usize::MAX; n];
+    for (i, p) in drawing.pieces.iter().enumerate() {
+        if !chained[i] {
+            new_index[i] = merged.pieces.len();
+            merged.pieces.push(p.clone());
+            origin.push(Ok(i));
+        }
+    }
+    for (k, c) in chains.iter().enumerate() {
+        let mut path: Option<Path> = None;
+        for &(i, rev) in c {
+            let p = if rev { drawing.pieces[i].path.reversed() } else { drawing.pieces[i].path.clone() };
+            match &mut path {
+                None => path = Some(p),
+                Some(acc) => {
+                    if acc.end() != p.start {
+                        acc.segs.push(crate::geom::Seg::Line(p.start));
+                    }
+                    acc.segs.extend(p.segs);
+                }
+            }
+        }
+        let first = c[0].0;
+        let Some(path) = path else { continue };
+        merged.pieces.push(crate::model::Piece {
+            id: format!("{}+{}", drawing.pieces[first].id, c.len() - 1),
+            operation: drawing.pieces[first].operation,
+            path,
+            reversible: true,
+            fixed: false,
+        });
+        origin.push(Err(k));
+    }
+    merged.hierarchy = drawing.hierarchy.iter().map(|&(a, b)| (new_index[a], new_index[b])).collect();
+    let mut report = order(&merged, opts)?;
+    let mut expanded = Vec::with_capacity(n);
+    for pl in &report.placements {
+        match origin[pl.piece] {
+            Ok(i) => expanded.push(Placement { piece: i, ..pl.clone() }),
+            Err(k) => {
+                let c = &chains[k];
+                let items: Vec<(usize, bool)> = if pl.reversed { c.iter().rev().map(|&(i, r)| (i, !r)).collect() } else { c.clone() };
+                for (i, rev) in items {
+                    let p = &drawing.pieces[i].path;
+                    expanded.push(Placement { piece: i, path: if rev { p.reversed() } else { p.clone() }, reversed: rev, lead_in: None });
+                }
+            }
+        }
+    }
+    report.placements = expanded;
+    report.travel_before = travel(opts.start, &crate::model::as_drawn(drawing));
+    report.travel_after = travel(opts.start, &report.placements);
+    Ok(report)
+}
