@@ -184,3 +184,29 @@ fn operations_keep_their_order() {
     assert!(ops.windows(2).all(|w| w[0] <= w[1]));
     assert!(verify(&d, &r.placements, &rules(&o)).ok());
 }
+
+#[test]
+fn merged_strokes_are_drawn_head_to_tail() {
+    // A zigzag cut into 6 strokes, listed shuffled and some reversed: merged, they are drawn as
+    // one chain (each stroke starts where the one before ended).
+    let pts: Vec<P2> = (0..7).map(|i| [i as f64 * 10.0, if i % 2 == 0 { 0.0 } else { 10.0 }]).collect();
+    let mut pieces: Vec<Piece> = (0..6).map(|i| piece(&format!("z{i}"), Path::polyline(&[pts[i], pts[i + 1]], false).unwrap())).collect();
+    pieces.swap(0, 4);
+    pieces[2].path = pieces[2].path.reversed();
+    pieces.push(piece("far", Path::polyline(&[[200.0, 200.0], [210.0, 200.0]], false).unwrap()));
+    let d = drawing(pieces);
+    let o = opts();
+    let chains = towpath_cut::order::merge_chains(&d, 1e-6);
+    assert_eq!(chains.len(), 1);
+    assert_eq!(chains[0].len(), 6);
+    let r = towpath_cut::order::order_merged(&d, &o, 1e-6).unwrap();
+    assert!(verify(&d, &r.placements, &rules(&o)).ok());
+    let zig: Vec<&Placement> = r.placements.iter().filter(|p| d.pieces[p.piece].id.starts_with('z')).collect();
+    let first = r.placements.iter().position(|p| d.pieces[p.piece].id.starts_with('z')).unwrap();
+    assert!(r.placements[first..first + 6].iter().all(|p| d.pieces[p.piece].id.starts_with('z')));
+    for w in zig.windows(2) {
+        assert!(dist(w[0].path.end(), w[1].path.start) < 1e-9);
+    }
+    // Merged travel: from the origin to the chain's nearer end (0,0) then to "far".
+    assert!((r.travel_after - (0.0 + dist([60.0, 0.0], [200.0, 200.0]))).abs() < 1e-9, "{}", r.travel_after);
+}
