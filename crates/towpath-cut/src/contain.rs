@@ -127,7 +127,11 @@ pub fn containers(drawing: &Drawing, shapes: &Shapes, tol: f64, only_same_operat
         let pts = &shapes.points[a];
         let step = pts.len().div_ceil(MAX_TESTED_POINTS).max(1);
         let env = AABB::from_corners([b[0] + tol, b[1] + tol], [b[2] - tol, b[3] - tol]);
-        let env = if b[2] - b[0] > 2.0 * tol && b[3] - b[1] > 2.0 * tol { env } else { AABB::from_corners([b[0], b[1]], [b[2], b[3]]) };
+        let env = if b[2] - b[0] > 2.0 * tol && b[3] - b[1] > 2.0 * tol {
+            env
+        } else {
+            AABB::from_corners([b[0], b[1]], [b[2], b[3]])
+        };
         for c in tree.locate_in_envelope_intersecting(&env) {
             let k = c.piece;
             if k == a || (only_same_operation && drawing.pieces[k].operation != drawing.pieces[a].operation) {

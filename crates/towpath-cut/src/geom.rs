@@ -110,10 +110,7 @@ pub fn seg_point(from: P2, seg: &Seg, t: f64) -> P2 {
         Seg::Cubic { c1, c2, to } => {
             let u = 1.0 - t;
             let (a, b, c, d) = (u * u * u, 3.0 * u * u * t, 3.0 * u * t * t, t * t * t);
-            [
-                a * from[0] + b * c1[0] + c * c2[0] + d * to[0],
-                a * from[1] + b * c1[1] + c * c2[1] + d * to[1],
-            ]
+            [a * from[0] + b * c1[0] + c * c2[0] + d * to[0], a * from[1] + b * c1[1] + c * c2[1] + d * to[1]]
         }
     }
 }
@@ -209,10 +206,8 @@ impl Path {
     pub fn polyline(points: &[P2], closed: bool) -> Option<Path> {
         let (&start, rest) = points.split_first()?;
         let mut segs: Vec<Seg> = rest.iter().map(|&p| Seg::Line(p)).collect();
-        if closed {
-            if segs.last().map(|s| s.end()) != Some(start) {
-                segs.push(Seg::Line(start));
-            }
+        if closed && segs.last().map(|s| s.end()) != Some(start) {
+            segs.push(Seg::Line(start));
         }
         Some(Path { start, segs, closed })
     }
@@ -306,7 +301,7 @@ impl Path {
     /// at most `max` of them.
     pub fn places_at_spacing(&self, spacing: f64, max: usize) -> Vec<Place> {
         let mut out = Vec::new();
-        if !(spacing > 0.0) || max == 0 {
+        if spacing.is_nan() || spacing <= 0.0 || max == 0 {
             return out;
         }
         let mut next = spacing;
@@ -411,10 +406,9 @@ mod tests {
     #[test]
     fn split_arc_and_cubic_keep_points() {
         let from = [0.0, 0.0];
-        for s in [
-            Seg::Arc { to: [2.0, 0.0], bulge: 0.7 },
-            Seg::Cubic { c1: [0.0, 1.0], c2: [2.0, 1.0], to: [2.0, 0.0] },
-        ] {
+        for s in
+            [Seg::Arc { to: [2.0, 0.0], bulge: 0.7 }, Seg::Cubic { c1: [0.0, 1.0], c2: [2.0, 1.0], to: [2.0, 0.0] }]
+        {
             let (a, b) = seg_split(from, &s, 0.3);
             let m = a.end();
             assert!(close(m, seg_point(from, &s, 0.3)));

@@ -50,7 +50,11 @@ pub fn lead_in(path: &Path, at: Place, poly: &[P2], depth: usize, lead: &LeadIn,
             let s = [c[0] - l * tangent[0], c[1] - l * tangent[1]];
             // Signed quarter turn from (s - c) = -t to (e - c) = -n.
             let cross = tangent[0] * n[1] - tangent[1] * n[0];
-            let bulge = if cross >= 0.0 { (std::f64::consts::FRAC_PI_2 / 4.0).tan() } else { -(std::f64::consts::FRAC_PI_2 / 4.0).tan() };
+            let bulge = if cross >= 0.0 {
+                (std::f64::consts::FRAC_PI_2 / 4.0).tan()
+            } else {
+                -(std::f64::consts::FRAC_PI_2 / 4.0).tan()
+            };
             Path { start: s, segs: vec![Seg::Arc { to: e, bulge }], closed: false }
         }
     }

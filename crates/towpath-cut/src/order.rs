@@ -204,7 +204,14 @@ fn prepare(drawing: &Drawing, shapes: &Shapes, opts: &OrderOptions) -> Prepared 
     Prepared { candidates, depth }
 }
 
-fn placement(drawing: &Drawing, shapes: &Shapes, prep: &Prepared, opts: &OrderOptions, piece: usize, c: &Candidate) -> Placement {
+fn placement(
+    drawing: &Drawing,
+    shapes: &Shapes,
+    prep: &Prepared,
+    opts: &OrderOptions,
+    piece: usize,
+    c: &Candidate,
+) -> Placement {
     let src = &drawing.pieces[piece].path;
     let (path, lead) = match c.place {
         Some(place) => {
@@ -249,7 +256,10 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
         if group_of[a] > group_of[b] {
             return Err(CutError::Hierarchy(format!(
                 "piece {} must come before piece {}, but its operation {:?} comes after {:?}",
-                drawing.pieces[a].id, drawing.pieces[b].id, drawing.operations[drawing.pieces[a].operation], drawing.operations[drawing.pieces[b].operation]
+                drawing.pieces[a].id,
+                drawing.pieces[b].id,
+                drawing.operations[drawing.pieces[a].operation],
+                drawing.operations[drawing.pieces[b].operation]
             )));
         }
     }
@@ -303,14 +313,35 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
         }
         b.end(End::Free);
         let problem = b.build().map_err(|e| CutError::Hierarchy(e.to_string()))?;
-        let mut sopts = opts.solve.clone();
+        // The input order is not handed to the solver (under a time limit a given start lets
+        // the construction stop early); it is kept instead when it is feasible and cheaper.
         let initial: Vec<Step> = (0..group.len() as u32).map(|t| Step { task: TaskId(t), mode: 0 }).collect();
-        sopts.initial = check(&problem, &initial).is_ok().then_some(initial);
+        let initial_cost = check(&problem, &initial).ok();
         let t0 = Instant::now();
-        let report = solve_with(opts.solver, &problem, &sopts, &opts.params).map_err(|e| CutError::Solver(e.to_string()))?;
+        // A nearest-neighbour tour over a grid of entries (precedence kept) is the solver's
+        // start: O(n) on spread-out drawings, where the solver's own construction is O(n²).
+        let mut group_pairs = Vec::new();
+        for &(x, y) in &pairs {
+            if task_of[x] != u32::MAX && task_of[y] != u32::MAX {
+                group_pairs.push((task_of[x] as usize, task_of[y] as usize));
+            }
+        }
+        let ends: Vec<Vec<(P2, P2)>> =
+            group.iter().map(|&i| prep.candidates[i].iter().map(|c| (c.entry, c.exit)).collect()).collect();
+        let greedy_steps = greedy(&ends, &group_pairs, at);
+        let mut sopts = opts.solve.clone();
+        if check(&problem, &greedy_steps).is_ok() {
+            sopts.initial = Some(greedy_steps);
+        }
+        let report =
+            solve_with(opts.solver, &problem, &sopts, &opts.params).map_err(|e| CutError::Solver(e.to_string()))?;
         solve_seconds += t0.elapsed().as_secs_f64();
         iterations += report.iterations;
-        for s in &report.solution.steps {
+        let steps = match initial_cost {
+            Some(c) if c < report.solution.cost => initial,
+            _ => report.solution.steps,
+        };
+        for s in &steps {
             let i = group[s.task.index()];
             let c = &prep.candidates[i][s.mode as usize];
             placements.push(placement(drawing, &shapes, &prep, opts, i, c));
@@ -345,12 +376,15 @@ fn refine(drawing: &Drawing, shapes: &Shapes, prep: &Prepared, opts: &OrderOptio
             }
             let prev = if k == 0 { opts.start } else { Some(placements[k - 1].exit()) };
             let next = placements.get(k + 1).map(|p| p.entry());
-            let price = |entry: P2, exit: P2| prev.map_or(0.0, |p| dist(p, entry)) + next.map_or(0.0, |q| dist(exit, q));
+            let price =
+                |entry: P2, exit: P2| prev.map_or(0.0, |p| dist(p, entry)) + next.map_or(0.0, |q| dist(exit, q));
             let cur = price(placements[k].entry(), placements[k].exit());
             let eval = |place: Place| -> f64 {
                 let p = src.point(place);
                 let entry = match &opts.lead_in {
-                    Some(l) => lead_in(src, place, &shapes.points[piece], prep.depth[piece], l, tangent(src, place)).start,
+                    Some(l) => {
+                        lead_in(src, place, &shapes.points[piece], prep.depth[piece], l, tangent(src, place)).start
+                    }
                     None => p,
                 };
                 price(entry, p)
@@ -544,10 +578,16 @@ pub fn order_merged(drawing: &Drawing, opts: &OrderOptions, tol: f64) -> Result<
             Ok(i) => expanded.push(Placement { piece: i, ..pl.clone() }),
             Err(k) => {
                 let c = &chains[k];
-                let items: Vec<(usize, bool)> = if pl.reversed { c.iter().rev().map(|&(i, r)| (i, !r)).collect() } else { c.clone() };
+                let items: Vec<(usize, bool)> =
+                    if pl.reversed { c.iter().rev().map(|&(i, r)| (i, !r)).collect() } else { c.clone() };
                 for (i, rev) in items {
                     let p = &drawing.pieces[i].path;
-                    expanded.push(Placement { piece: i, path: if rev { p.reversed() } else { p.clone() }, reversed: rev, lead_in: None });
+                    expanded.push(Placement {
+                        piece: i,
+                        path: if rev { p.reversed() } else { p.clone() },
+                        reversed: rev,
+                        lead_in: None,
+                    });
                 }
             }
         }
@@ -556,4 +596,96 @@ pub fn order_merged(drawing: &Drawing, opts: &OrderOptions, tol: f64) -> Result<
     report.travel_before = travel(opts.start, &crate::model::as_drawn(drawing));
     report.travel_after = travel(opts.start, &report.placements);
     Ok(report)
+}
+
+/// A nearest-neighbour route: from `start` (or the first task's entry), always the available
+/// task (every predecessor done) with the nearest entry, found in a uniform grid of entries.
+/// `ends[t]` lists task t's modes as (entry, exit); `pairs` are (before, after) task pairs.
+pub fn greedy(ends: &[Vec<(P2, P2)>], pairs: &[(usize, usize)], start: Option<P2>) -> Vec<Step> {
+    let n = ends.len();
+    let mut indeg = vec![0usize; n];
+    let mut succ: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for &(a, b) in pairs {
+        if a < n && b < n {
+            indeg[b] += 1;
+            succ[a].push(b);
+        }
+    }
+    let all: Vec<P2> = ends.iter().flatten().map(|e| e.0).collect();
+    if all.is_empty() {
+        return Vec::new();
+    }
+    let bb = crate::geom::bbox_of(&all);
+    let (w, h) = ((bb[2] - bb[0]).max(1e-9), (bb[3] - bb[1]).max(1e-9));
+    let cell = ((w * h) / all.len() as f64).sqrt().max(w.max(h) / 4096.0);
+    let gx = ((w / cell) as usize + 1).min(4096);
+    let gy = ((h / cell) as usize + 1).min(4096);
+    let cell_of = |p: P2| -> (usize, usize) {
+        let x = (((p[0] - bb[0]) / cell) as isize).clamp(0, gx as isize - 1) as usize;
+        let y = (((p[1] - bb[1]) / cell) as isize).clamp(0, gy as isize - 1) as usize;
+        (x, y)
+    };
+    let mut grid: Vec<Vec<(u32, u32)>> = vec![Vec::new(); gx * gy];
+    let mut used = vec![false; n];
+    let mut available = 0usize;
+    let add = |t: usize, grid: &mut Vec<Vec<(u32, u32)>>, available: &mut usize| {
+        *available += 1;
+        for (m, e) in ends[t].iter().enumerate() {
+            let (x, y) = cell_of(e.0);
+            grid[y * gx + x].push((t as u32, m as u32));
+        }
+    };
+    for t in 0..n {
+        if indeg[t] == 0 {
+            add(t, &mut grid, &mut available);
+        }
+    }
+    let mut steps = Vec::with_capacity(n);
+    let mut at = start.unwrap_or_else(|| ends.iter().find_map(|e| e.first().map(|x| x.0)).unwrap_or([0.0, 0.0]));
+    while available > 0 {
+        let (cx, cy) = cell_of(at);
+        let mut best: Option<(f64, u32, u32)> = None;
+        let mut r = 0usize;
+        loop {
+            let (x0, x1) = (cx.saturating_sub(r), (cx + r).min(gx - 1));
+            let (y0, y1) = (cy.saturating_sub(r), (cy + r).min(gy - 1));
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    // Cells inside the ring were searched at a smaller radius.
+                    let (dx, dy) =
+                        ((x as isize - cx as isize).unsigned_abs(), (y as isize - cy as isize).unsigned_abs());
+                    if dx.max(dy) < r {
+                        continue;
+                    }
+                    let bucket = &mut grid[y * gx + x];
+                    bucket.retain(|&(t, _)| !used[t as usize]);
+                    for &(t, m) in bucket.iter() {
+                        let d = dist(at, ends[t as usize][m as usize].0);
+                        if best.is_none_or(|b| d < b.0 || (d == b.0 && (t, m) < (b.1, b.2))) {
+                            best = Some((d, t, m));
+                        }
+                    }
+                }
+            }
+            let covered = cx < r && cy < r && cx + r >= gx - 1 && cy + r >= gy - 1;
+            if best.is_some_and(|b| b.0 <= r as f64 * cell) || covered {
+                break;
+            }
+            r += 1;
+        }
+        let Some((_, t, m)) = best else { break };
+        let t = t as usize;
+        used[t] = true;
+        available -= 1;
+        steps.push(Step { task: TaskId(t as u32), mode: m });
+        at = ends[t][m as usize].1;
+        for k in 0..succ[t].len() {
+            let s = succ[t][k];
+            indeg[s] -= 1;
+            if indeg[s] == 0 {
+                add(s, &mut grid, &mut available);
+            }
+        }
+    }
+    steps
 }

@@ -118,7 +118,8 @@ fn same_geometry(orig: &Path, done: &Path, reversed: bool, may_reverse: bool, to
         if reversed && !may_reverse {
             return Err("reversed, which is not allowed".into());
         }
-        if !(fwd && !reversed || back && reversed || fwd && back) {
+        let consistent = if reversed { back } else { fwd };
+        if !consistent {
             return Err("ends do not match the original".into());
         }
     }
@@ -164,7 +165,9 @@ pub fn verify(drawing: &Drawing, done: &[Placement], rules: &Rules) -> Verificat
         if piece.fixed && p.path != piece.path {
             v.geometry.push(format!("{}: must be done as drawn", piece.id));
         }
-        if let Err(e) = same_geometry(&piece.path, &p.path, p.reversed, rules.reverse && piece.reversible, rules.tolerance) {
+        if let Err(e) =
+            same_geometry(&piece.path, &p.path, p.reversed, rules.reverse && piece.reversible, rules.tolerance)
+        {
             v.geometry.push(format!("{}: {e}", piece.id));
         }
         if let Some(l) = &p.lead_in {
@@ -247,7 +250,12 @@ pub fn verify(drawing: &Drawing, done: &[Placement], rules: &Rules) -> Verificat
                         true
                     }
                 });
-                if inside && (strictly || drawing.pieces[a].path.closed) && pos[a] != usize::MAX && pos[c] != usize::MAX && pos[a] > pos[c] {
+                if inside
+                    && (strictly || drawing.pieces[a].path.closed)
+                    && pos[a] != usize::MAX
+                    && pos[c] != usize::MAX
+                    && pos[a] > pos[c]
+                {
                     v.precedence.push(format!("{} lies inside {} but comes after it", name(a), name(c)));
                 }
             }

@@ -38,17 +38,21 @@ fn round_trip(format: Format, text: &str, tol: f64) -> (Drawing, Drawing) {
         let best = (0..d.pieces.len())
             .filter(|&i| !used[i] && d.pieces[i].path.closed == p.path.closed)
             .min_by(|&a, &b| {
-                let da = (d.pieces[a].path.length() - p.path.length()).abs() + dist(d.pieces[a].path.end(), p.path.end()).min(dist(d.pieces[a].path.start, p.path.end()));
-                let db = (d.pieces[b].path.length() - p.path.length()).abs() + dist(d.pieces[b].path.end(), p.path.end()).min(dist(d.pieces[b].path.start, p.path.end()));
+                let da = (d.pieces[a].path.length() - p.path.length()).abs()
+                    + dist(d.pieces[a].path.end(), p.path.end()).min(dist(d.pieces[a].path.start, p.path.end()));
+                let db = (d.pieces[b].path.length() - p.path.length()).abs()
+                    + dist(d.pieces[b].path.end(), p.path.end()).min(dist(d.pieces[b].path.start, p.path.end()));
                 da.total_cmp(&db)
             })
             .unwrap();
         used[best] = true;
-        let reversed = !p.path.closed && dist(p.path.start, d.pieces[best].path.start) > dist(p.path.start, d.pieces[best].path.end());
+        let reversed = !p.path.closed
+            && dist(p.path.start, d.pieces[best].path.start) > dist(p.path.start, d.pieces[best].path.end());
         placements.push(Placement { piece: best, path: p.path.clone(), reversed, lead_in: None });
     }
     let o = opts();
-    let rules = Rules { inner_first: true, mix_operations: false, reverse: true, tolerance: tol * 10.0, start: o.start };
+    let rules =
+        Rules { inner_first: true, mix_operations: false, reverse: true, tolerance: tol * 10.0, start: o.start };
     let v = verify(&d, &placements, &rules);
     assert!(v.ok(), "{}", v.problems());
     // The order written is the order chosen.
@@ -103,7 +107,14 @@ fn svg_round_trip_keeps_geometry_layers_and_attributes() {
     let (_, src) = read(Format::Svg, SVG, "t.svg", 1e-3).unwrap();
     let r = order(&d, &opts()).unwrap();
     let out = write(&src, &d, &r.placements).unwrap();
-    for kept in ["inkscape:label=\"Engrave\"", "<text x=\"0\" y=\"0\">label</text>", "id=\"outer\"", "stroke=\"red\"", "stroke=\"blue\"", "<style>"] {
+    for kept in [
+        "inkscape:label=\"Engrave\"",
+        "<text x=\"0\" y=\"0\">label</text>",
+        "id=\"outer\"",
+        "stroke=\"red\"",
+        "stroke=\"blue\"",
+        "<style>",
+    ] {
         assert!(out.contains(kept), "{kept} missing in {out}");
     }
     // The hole comes before the outer contour in the output text.
@@ -128,9 +139,13 @@ fn dxf_text() -> String {
     add("CUT", EntityType::LwPolyline(lw));
     add("ENGRAVE", EntityType::Line(Line::new(dxf::Point::new(20.0, 20.0, 0.0), dxf::Point::new(30.0, 25.0, 0.0))));
     add("ENGRAVE", EntityType::Arc(Arc::new(dxf::Point::new(70.0, 20.0, 0.0), 5.0, 10.0, 200.0)));
-    let mut sp = Spline::default();
-    sp.degree_of_curve = 3;
-    sp.control_points = vec![dxf::Point::new(10.0, 80.0, 0.0), dxf::Point::new(20.0, 90.0, 0.0), dxf::Point::new(30.0, 70.0, 0.0), dxf::Point::new(40.0, 80.0, 0.0)];
+    let mut sp = Spline { degree_of_curve: 3, ..Default::default() };
+    sp.control_points = vec![
+        dxf::Point::new(10.0, 80.0, 0.0),
+        dxf::Point::new(20.0, 90.0, 0.0),
+        dxf::Point::new(30.0, 70.0, 0.0),
+        dxf::Point::new(40.0, 80.0, 0.0),
+    ];
     sp.knot_values = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
     add("ENGRAVE", EntityType::Spline(sp));
     let mut buf = Vec::new();
@@ -215,12 +230,21 @@ fn refused_input_names_the_line_or_element() {
     assert!(e.starts_with("w.nc:1:") && e.contains("'Y'"), "{e}");
     let e = read(Format::Gcode, "G0 X0 Y0\nG2 X10 Y0 I1 J1\n", "a.nc", 1e-3).unwrap_err().to_string();
     assert!(e.starts_with("a.nc:2:"), "{e}");
-    let e = read(Format::Svg, "<svg xmlns=\"http://www.w3.org/2000/svg\">\n<path d=\"M0 0\"></svg>", "x.svg", 1e-3).unwrap_err().to_string();
+    let e = read(Format::Svg, "<svg xmlns=\"http://www.w3.org/2000/svg\">\n<path d=\"M0 0\"></svg>", "x.svg", 1e-3)
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("x.svg:2:"), "{e}");
     let j = r#"{"format": "towpath-cut/1", "pieces": [{"id": "a", "closed": true, "points": [[0,0],[1,1]]}]}"#;
     let e = read(Format::Json, j, "c.json", 1e-3).unwrap_err().to_string();
     assert!(e.contains("pieces[0] (id \"a\")") && e.contains("marked closed"), "{e}");
-    let e = read(Format::Dxf, "0\nSECTION\n2\nENTITIES\n0\nCIRCLE\n8\n0\n10\n1\n20\n1\n40\n0\n0\nENDSEC\n0\nEOF\n", "c.dxf", 1e-3).unwrap_err().to_string();
+    let e = read(
+        Format::Dxf,
+        "0\nSECTION\n2\nENTITIES\n0\nCIRCLE\n8\n0\n10\n1\n20\n1\n40\n0\n0\nENDSEC\n0\nEOF\n",
+        "c.dxf",
+        1e-3,
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("CIRCLE") && e.contains("radius"), "{e}");
 }
 
@@ -267,4 +291,3 @@ proptest! {
         }
     }
 }
-

@@ -7,7 +7,10 @@ use towpath_cut::mill::{cells_for_tool, check_plan, offset_levels, plan, read_pa
 use towpath_seq::SolveOptions;
 
 fn opts() -> MillOptions {
-    MillOptions { solve: SolveOptions { time_limit: None, iterations: Some(200), threads: 1, ..SolveOptions::default() }, ..MillOptions::default() }
+    MillOptions {
+        solve: SolveOptions { time_limit: None, iterations: Some(200), threads: 1, ..SolveOptions::default() },
+        ..MillOptions::default()
+    }
 }
 
 fn rect_part(w: f64, h: f64, r: f64, s: f64) -> String {
@@ -21,7 +24,8 @@ fn rect_part(w: f64, h: f64, r: f64, s: f64) -> String {
 fn rectangle_offsets_give_the_analytic_number_of_loops() {
     // Loops at distances r, r + s, r + 2s, ... exist while the distance is below half the
     // shorter side: count = floor((h/2 - r) / s) + 1 (values chosen off the boundary cases).
-    for (w, h, r, s) in [(100.0, 40.0, 3.0, 4.0), (60.0, 30.0, 5.0, 2.2), (50.0, 50.0, 1.0, 1.4), (30.0, 9.0, 4.0, 1.0)] {
+    for (w, h, r, s) in [(100.0, 40.0, 3.0, 4.0), (60.0, 30.0, 5.0, 2.2), (50.0, 50.0, 1.0, 1.4), (30.0, 9.0, 4.0, 1.0)]
+    {
         let part = read_part(&rect_part(w, h, r, s), "rect.json").unwrap();
         let levels = offset_levels(&part.features[0], r, s);
         let expected = (((h / 2.0 - r) / s).floor() as usize) + 1;
@@ -31,7 +35,13 @@ fn rectangle_offsets_give_the_analytic_number_of_loops() {
             // The k-th loop is the rectangle shrunk by r + k s (rounded corners: bbox exact).
             let d = r + s * k as f64;
             let b = level[0].outer.bbox(1e-4);
-            assert!((b[0] - d).abs() < 1e-6 && (b[1] - d).abs() < 1e-6 && (b[2] - (w - d)).abs() < 1e-6 && (b[3] - (h - d)).abs() < 1e-6, "{b:?} at {d}");
+            assert!(
+                (b[0] - d).abs() < 1e-6
+                    && (b[1] - d).abs() < 1e-6
+                    && (b[2] - (w - d)).abs() < 1e-6
+                    && (b[3] - (h - d)).abs() < 1e-6,
+                "{b:?} at {d}"
+            );
         }
         let cells = cells_for_tool(&part, 0);
         assert_eq!(cells.len(), 1);
@@ -64,8 +74,10 @@ fn dumbbell_splits_into_cells_linked_in_a_legal_order() {
     let p = plan(&part, &o).unwrap();
     assert!(check_plan(&part, &p, false).is_empty());
     let t1 = &p.tools[0];
-    let plate_cells: Vec<usize> = t1.cells.iter().enumerate().filter(|(_, c)| part.features[c.feature].id == "plate").map(|(i, _)| i).collect();
-    let bell_cells: Vec<usize> = t1.cells.iter().enumerate().filter(|(_, c)| part.features[c.feature].id == "bell").map(|(i, _)| i).collect();
+    let plate_cells: Vec<usize> =
+        t1.cells.iter().enumerate().filter(|(_, c)| part.features[c.feature].id == "plate").map(|(i, _)| i).collect();
+    let bell_cells: Vec<usize> =
+        t1.cells.iter().enumerate().filter(|(_, c)| part.features[c.feature].id == "bell").map(|(i, _)| i).collect();
     let at = |c: usize| t1.order.iter().position(|(x, _)| *x == c).unwrap();
     for &pc in &plate_cells {
         for &bc in &bell_cells {

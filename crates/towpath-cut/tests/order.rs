@@ -9,7 +9,8 @@ use towpath_cut::{order, verify, Drawing, EntryMode, OrderOptions, Piece, Placem
 use towpath_seq::SolveOptions;
 
 fn square(c: P2, h: f64) -> Path {
-    Path::polyline(&[[c[0] - h, c[1] - h], [c[0] + h, c[1] - h], [c[0] + h, c[1] + h], [c[0] - h, c[1] + h]], true).unwrap()
+    Path::polyline(&[[c[0] - h, c[1] - h], [c[0] + h, c[1] - h], [c[0] + h, c[1] + h], [c[0] - h, c[1] + h]], true)
+        .unwrap()
 }
 
 fn piece(id: &str, path: Path) -> Piece {
@@ -24,7 +25,13 @@ fn opts() -> OrderOptions {
 }
 
 fn rules(o: &OrderOptions) -> Rules {
-    Rules { inner_first: o.inner_first, mix_operations: o.mix_operations, reverse: o.reverse, tolerance: o.tolerance, start: o.start }
+    Rules {
+        inner_first: o.inner_first,
+        mix_operations: o.mix_operations,
+        reverse: o.reverse,
+        tolerance: o.tolerance,
+        start: o.start,
+    }
 }
 
 fn drawing(pieces: Vec<Piece>) -> Drawing {
@@ -78,9 +85,20 @@ fn strokes_match_brute_force() {
     for _case in 0..20 {
         let n = rng.gen_range(2..=7);
         let strokes: Vec<(P2, P2)> = (0..n)
-            .map(|_| ([rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0)], [rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0)]))
+            .map(|_| {
+                (
+                    [rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0)],
+                    [rng.gen_range(0.0..100.0), rng.gen_range(0.0..100.0)],
+                )
+            })
             .collect();
-        let d = drawing(strokes.iter().enumerate().map(|(i, s)| piece(&format!("p{i}"), Path::polyline(&[s.0, s.1], false).unwrap())).collect());
+        let d = drawing(
+            strokes
+                .iter()
+                .enumerate()
+                .map(|(i, s)| piece(&format!("p{i}"), Path::polyline(&[s.0, s.1], false).unwrap()))
+                .collect(),
+        );
         let o = opts();
         let r = order(&d, &o).unwrap();
         let best = brute_force([0.0, 0.0], &strokes);
@@ -126,7 +144,10 @@ fn random_drawing(seed: u64, n: usize) -> Drawing {
                 pieces.push(piece(&format!("outer{i}"), square(c, 8.0)));
                 pieces.push(piece(&format!("hole{i}"), square(c, 3.0).reversed()));
             }
-            1 => pieces.push(piece(&format!("stroke{i}"), Path::polyline(&[c, [c[0] + 5.0, c[1] + 3.0], [c[0] + 9.0, c[1]]], false).unwrap())),
+            1 => pieces.push(piece(
+                &format!("stroke{i}"),
+                Path::polyline(&[c, [c[0] + 5.0, c[1] + 3.0], [c[0] + 9.0, c[1]]], false).unwrap(),
+            )),
             _ => {
                 let mut p = Path::polyline(&[c, [c[0] + 6.0, c[1]]], false).unwrap();
                 p.segs[0] = towpath_cut::Seg::Arc { to: [c[0] + 6.0, c[1]], bulge: 0.6 };
@@ -190,7 +211,8 @@ fn merged_strokes_are_drawn_head_to_tail() {
     // A zigzag cut into 6 strokes, listed shuffled and some reversed: merged, they are drawn as
     // one chain (each stroke starts where the one before ended).
     let pts: Vec<P2> = (0..7).map(|i| [i as f64 * 10.0, if i % 2 == 0 { 0.0 } else { 10.0 }]).collect();
-    let mut pieces: Vec<Piece> = (0..6).map(|i| piece(&format!("z{i}"), Path::polyline(&[pts[i], pts[i + 1]], false).unwrap())).collect();
+    let mut pieces: Vec<Piece> =
+        (0..6).map(|i| piece(&format!("z{i}"), Path::polyline(&[pts[i], pts[i + 1]], false).unwrap())).collect();
     pieces.swap(0, 4);
     pieces[2].path = pieces[2].path.reversed();
     pieces.push(piece("far", Path::polyline(&[[200.0, 200.0], [210.0, 200.0]], false).unwrap()));

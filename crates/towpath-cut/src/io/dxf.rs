@@ -45,7 +45,7 @@ fn bspline_point(degree: usize, knots: &[f64], ctrl: &[P2], w: &[f64], u: f64) -
     }
     let mut d: Vec<[f64; 3]> = (0..=degree)
         .map(|j| {
-            let i = (k + j).checked_sub(degree).unwrap_or(0).min(n - 1);
+            let i = (k + j).saturating_sub(degree).min(n - 1);
             let wi = w.get(i).copied().unwrap_or(1.0);
             [ctrl[i][0] * wi, ctrl[i][1] * wi, wi]
         })
@@ -67,7 +67,7 @@ fn bspline_point(degree: usize, knots: &[f64], ctrl: &[P2], w: &[f64], u: f64) -
 fn spline_points(s: &dxf::entities::Spline, tol: f64) -> Vec<P2> {
     let ctrl: Vec<P2> = s.control_points.iter().map(|p| [p.x, p.y]).collect();
     let degree = s.degree_of_curve.max(1) as usize;
-    if ctrl.len() > degree && s.knot_values.len() >= ctrl.len() + degree + 1 && ctrl.len() < 100_000 {
+    if ctrl.len() > degree && s.knot_values.len() > ctrl.len() + degree && ctrl.len() < 100_000 {
         let (u0, u1) = (s.knot_values[degree], s.knot_values[ctrl.len()]);
         // Samples: enough per span for the tolerance on a curve this size.
         let poly_len: f64 = ctrl.windows(2).map(|w| crate::geom::dist(w[0], w[1])).sum();
@@ -126,7 +126,7 @@ fn entity_path(e: &dxf::entities::Entity, tol: f64, what: &str) -> Result<Option
             path_from(&pts, &bul, p.flags & 1 != 0, what)?
         }
         T::Arc(a) => {
-            if !(a.radius > 0.0) || !a.radius.is_finite() {
+            if a.radius.is_nan() || a.radius <= 0.0 || !a.radius.is_finite() {
                 return Err(CutError::Input(format!("{what}: arc radius {} is not positive", a.radius)));
             }
             let (s, e) = (a.start_angle.to_radians(), a.end_angle.to_radians());
@@ -140,11 +140,14 @@ fn entity_path(e: &dxf::entities::Entity, tol: f64, what: &str) -> Result<Option
             let half = (sweep / 2.0 / 4.0).tan();
             let b = if z < 0.0 { -half } else { half };
             // Two halves keep every bulge well below 1 even for near-full arcs.
-            let segs = vec![Seg::Arc { to: mirrored(z, at(s + sweep / 2.0)), bulge: b }, Seg::Arc { to: mirrored(z, at(s + sweep)), bulge: b }];
+            let segs = vec![
+                Seg::Arc { to: mirrored(z, at(s + sweep / 2.0)), bulge: b },
+                Seg::Arc { to: mirrored(z, at(s + sweep)), bulge: b },
+            ];
             Path { start: mirrored(z, at(s)), segs, closed: false }
         }
         T::Circle(ci) => {
-            if !(ci.radius > 0.0) || !ci.radius.is_finite() {
+            if ci.radius.is_nan() || ci.radius <= 0.0 || !ci.radius.is_finite() {
                 return Err(CutError::Input(format!("{what}: circle radius {} is not positive", ci.radius)));
             }
             let c = [ci.center.x, ci.center.y];
@@ -189,7 +192,11 @@ pub fn read(text: &str, name: &str, tol: f64) -> Result<(Drawing, DxfSource), Cu
         match entity_path(e, tol, &what)? {
             Some(path) => {
                 let op = drawing.operation_index(&e.common.layer);
-                let id = if e.common.handle.0 != 0 { format!("{:X}", e.common.handle.0) } else { format!("entity {}", i + 1) };
+                let id = if e.common.handle.0 != 0 {
+                    format!("{:X}", e.common.handle.0)
+                } else {
+                    format!("entity {}", i + 1)
+                };
                 original.push(path.clone());
                 drawing.pieces.push(Piece { id, operation: op, path, reversible: true, fixed: false });
                 entities.push(e.clone());
@@ -225,8 +232,7 @@ fn polyline_entity(out: &mut dxf::Drawing, path: &Path, common: &dxf::entities::
         return lwpolyline(path, common);
     }
     let jp = crate::io::json::path_to(path);
-    let mut poly = dxf::entities::Polyline::default();
-    poly.flags = i32::from(path.closed);
+    let mut poly = dxf::entities::Polyline { flags: i32::from(path.closed), ..Default::default() };
     for (i, p) in jp.points.iter().enumerate() {
         let mut v = dxf::entities::Vertex::new(dxf::Point::new(p[0], p[1], 0.0));
         v.bulge = jp.bulges.get(i).copied().unwrap_or(0.0);
@@ -245,7 +251,12 @@ fn lwpolyline(path: &Path, common: &dxf::entities::EntityCommon) -> dxf::entitie
     let mut lw = dxf::entities::LwPolyline::default();
     lw.set_is_closed(path.closed);
     for (i, p) in jp.points.iter().enumerate() {
-        lw.vertices.push(dxf::LwPolylineVertex { x: p[0], y: p[1], bulge: jp.bulges.get(i).copied().unwrap_or(0.0), ..Default::default() });
+        lw.vertices.push(dxf::LwPolylineVertex {
+            x: p[0],
+            y: p[1],
+            bulge: jp.bulges.get(i).copied().unwrap_or(0.0),
+            ..Default::default()
+        });
     }
     let mut e = dxf::entities::Entity::new(dxf::entities::EntityType::LwPolyline(lw));
     e.common.layer = common.layer.clone();

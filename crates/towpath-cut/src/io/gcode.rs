@@ -96,7 +96,10 @@ fn words(line: &str, no: usize, name: &str) -> Result<Vec<(char, f64, String)>, 
                     }
                 }
                 let v: f64 = num.parse().map_err(|_| {
-                    CutError::Input(format!("{name}:{no}: word '{c}' has no number{}", if num.is_empty() { String::new() } else { format!(" ({num:?})") }))
+                    CutError::Input(format!(
+                        "{name}:{no}: word '{c}' has no number{}",
+                        if num.is_empty() { String::new() } else { format!(" ({num:?})") }
+                    ))
                 })?;
                 if !v.is_finite() {
                     return Err(CutError::Input(format!("{name}:{no}: word '{c}{num}' is not a finite number")));
@@ -150,10 +153,26 @@ pub fn read(text: &str, name: &str) -> Result<(Drawing, GcodeSource), CutError> 
                         10 => motion = Motion::Line,
                         20 => motion = Motion::Cw,
                         30 => motion = Motion::Ccw,
-                        910 => return Err(CutError::Input(format!("{name}:{no}: incremental coordinates (G91) are not supported; post the program with G90"))),
-                        901 => return Err(CutError::Input(format!("{name}:{no}: absolute arc centres (G90.1) are not supported; use incremental I/J (G91.1)"))),
-                        180 | 190 => return Err(CutError::Input(format!("{name}:{no}: arcs outside the XY plane (G18/G19) are not supported"))),
-                        920 => return Err(CutError::Input(format!("{name}:{no}: coordinate offsets (G92) are not supported"))),
+                        910 => {
+                            return Err(CutError::Input(format!(
+                            "{name}:{no}: incremental coordinates (G91) are not supported; post the program with G90"
+                        )))
+                        }
+                        901 => {
+                            return Err(CutError::Input(format!(
+                            "{name}:{no}: absolute arc centres (G90.1) are not supported; use incremental I/J (G91.1)"
+                        )))
+                        }
+                        180 | 190 => {
+                            return Err(CutError::Input(format!(
+                                "{name}:{no}: arcs outside the XY plane (G18/G19) are not supported"
+                            )))
+                        }
+                        920 => {
+                            return Err(CutError::Input(format!(
+                                "{name}:{no}: coordinate offsets (G92) are not supported"
+                            )))
+                        }
                         _ => {}
                     }
                     if matches!(g, 0 | 10 | 20 | 30) {
@@ -169,7 +188,7 @@ pub fn read(text: &str, name: &str) -> Result<(Drawing, GcodeSource), CutError> 
                 'Z' | 'A' | 'B' | 'C' | 'U' | 'V' | 'W' => other_axes = true,
                 'M' => {
                     let m = v.round() as i64;
-                    if matches!(m, 3 | 4 | 5) {
+                    if (3..=5).contains(&m) {
                         brk = true;
                     }
                 }
@@ -184,7 +203,8 @@ pub fn read(text: &str, name: &str) -> Result<(Drawing, GcodeSource), CutError> 
                 Motion::Line => Kind::Feed(Seg::Line(to), other_axes),
                 Motion::Cw | Motion::Ccw => {
                     let ccw = motion == Motion::Ccw;
-                    let seg = arc_seg(pos, to, ci, cj, r, ccw).map_err(|e| CutError::Input(format!("{name}:{no}: {e}")))?;
+                    let seg =
+                        arc_seg(pos, to, ci, cj, r, ccw).map_err(|e| CutError::Input(format!("{name}:{no}: {e}")))?;
                     Kind::Feed(seg, other_axes)
                 }
             }
@@ -282,7 +302,8 @@ pub fn read(text: &str, name: &str) -> Result<(Drawing, GcodeSource), CutError> 
             path.closed = false;
         }
         let (_, mode_before, feed_before, has_word, has_f) = &at_line[a];
-        let prefix_mode = at_line.get(prefix_start).map(|s| s.1).filter(|m| *m != Motion::Rapid).map(|m| m.word().to_string());
+        let prefix_mode =
+            at_line.get(prefix_start).map(|s| s.1).filter(|m| *m != Motion::Rapid).map(|m| m.word().to_string());
         let first_mode = match &kinds[a] {
             Kind::Feed(Seg::Arc { bulge, .. }, _) if *bulge < 0.0 => Motion::Cw,
             Kind::Feed(Seg::Arc { .. }, _) => Motion::Ccw,
@@ -302,7 +323,13 @@ pub fn read(text: &str, name: &str) -> Result<(Drawing, GcodeSource), CutError> 
             prefix_mode,
             original: path.clone(),
         });
-        drawing.pieces.push(Piece { id: format!("line {}", a + 1), operation: 0, path, reversible: true, fixed: extra });
+        drawing.pieces.push(Piece {
+            id: format!("line {}", a + 1),
+            operation: 0,
+            path,
+            reversible: true,
+            fixed: extra,
+        });
         prefix_start = next_prefix;
     }
     if runs.is_empty() {
@@ -366,7 +393,13 @@ fn moves(path: &Path, feed: Option<&str>, out: &mut Vec<String>) {
             Seg::Arc { to, bulge } => match arc_geometry(prev, to, bulge) {
                 Some((c, ..)) => {
                     let g = if bulge > 0.0 { "G3" } else { "G2" };
-                    out.push(format!("{g} X{} Y{} I{} J{}{f}", fmt(to[0]), fmt(to[1]), fmt(c[0] - prev[0]), fmt(c[1] - prev[1])));
+                    out.push(format!(
+                        "{g} X{} Y{} I{} J{}{f}",
+                        fmt(to[0]),
+                        fmt(to[1]),
+                        fmt(c[0] - prev[0]),
+                        fmt(c[1] - prev[1])
+                    ));
                 }
                 None => out.push(format!("G1 X{} Y{}{f}", fmt(to[0]), fmt(to[1]))),
             },

@@ -159,8 +159,8 @@ pub fn path_to(path: &Path) -> JsonPath {
 
 /// Reads a `towpath-cut/1` file.
 pub fn read(text: &str, name: &str) -> Result<(Drawing, JsonSource), CutError> {
-    let file: JsonDrawing = serde_json::from_str(text)
-        .map_err(|e| CutError::Input(format!("{name}:{}:{}: {e}", e.line(), e.column())))?;
+    let file: JsonDrawing =
+        serde_json::from_str(text).map_err(|e| CutError::Input(format!("{name}:{}:{}: {e}", e.line(), e.column())))?;
     if file.format != FORMAT {
         return Err(CutError::Input(format!("{name}: format {:?} is not {FORMAT:?}", file.format)));
     }
@@ -216,6 +216,11 @@ pub fn write(source: &JsonSource, drawing: &Drawing, order: &[Placement]) -> Str
             }
         })
         .collect();
-    let out = JsonDrawing { format: FORMAT.into(), units: source.units.clone(), operations: drawing.operations.clone(), pieces };
+    let out = JsonDrawing {
+        format: FORMAT.into(),
+        units: source.units.clone(),
+        operations: drawing.operations.clone(),
+        pieces,
+    };
     serde_json::to_string_pretty(&out).unwrap_or_default() + "\n"
 }

@@ -49,9 +49,9 @@ pub enum Source {
     /// JSON: nothing more.
     Json(json::JsonSource),
     /// SVG: the document text and each piece's element.
-    Svg(svg::SvgSource),
+    Svg(Box<svg::SvgSource>),
     /// DXF: the header and each piece's layer and entity.
-    Dxf(dxf::DxfSource),
+    Dxf(Box<dxf::DxfSource>),
     /// G-code: the program's lines and each piece's block.
     Gcode(gcode::GcodeSource),
 }
@@ -60,8 +60,8 @@ pub enum Source {
 pub fn read(format: Format, text: &str, name: &str, tol: f64) -> Result<(Drawing, Source), CutError> {
     match format {
         Format::Json => json::read(text, name).map(|(d, s)| (d, Source::Json(s))),
-        Format::Svg => svg::read(text, name, tol).map(|(d, s)| (d, Source::Svg(s))),
-        Format::Dxf => dxf::read(text, name, tol).map(|(d, s)| (d, Source::Dxf(s))),
+        Format::Svg => svg::read(text, name, tol).map(|(d, s)| (d, Source::Svg(Box::new(s)))),
+        Format::Dxf => dxf::read(text, name, tol).map(|(d, s)| (d, Source::Dxf(Box::new(s)))),
         Format::Gcode => gcode::read(text, name).map(|(d, s)| (d, Source::Gcode(s))),
     }
 }

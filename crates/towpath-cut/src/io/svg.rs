@@ -111,9 +111,9 @@ pub struct SvgSource {
     tol: f64,
 }
 
-fn pos_of(doc: &roxmltree::Document, at: usize) -> String {
-    let p = doc.text_pos_at(at);
-    format!("{}:{}", p.row, p.col)
+/// "line N" of a byte offset, from the offsets of the line starts.
+fn line_of(line_starts: &[usize], at: usize) -> String {
+    format!("line {}", line_starts.partition_point(|&s| s <= at))
 }
 
 /// The start tag's raw text range of a node.
@@ -160,7 +160,12 @@ fn parse_transform(v: Option<&str>) -> Affine {
 fn root_map(root: roxmltree::Node, size: (f64, f64)) -> Affine {
     let vb: Vec<f64> = root
         .attribute("viewBox")
-        .map(|v| v.split(|c: char| c == ',' || c.is_whitespace()).filter(|s| !s.is_empty()).filter_map(|s| s.parse().ok()).collect())
+        .map(|v| {
+            v.split(|c: char| c == ',' || c.is_whitespace())
+                .filter(|s| !s.is_empty())
+                .filter_map(|s| s.parse().ok())
+                .collect()
+        })
         .unwrap_or_default();
     if vb.len() != 4 || vb[2] <= 0.0 || vb[3] <= 0.0 {
         return IDENTITY;
@@ -185,6 +190,7 @@ pub fn read(text: &str, name: &str, tol: f64) -> Result<(Drawing, SvgSource), Cu
     }
     // Shape elements in document order, each tagged with a synthetic id for usvg.
     let top: Vec<roxmltree::Node> = root.children().filter(|n| n.is_element()).collect();
+    let top_index: HashMap<roxmltree::NodeId, usize> = top.iter().enumerate().map(|(i, n)| (n.id(), i)).collect();
     let mut elements = Vec::new();
     let mut inserts: Vec<(usize, usize, String)> = Vec::new();
     let mut by_tag: HashMap<String, usize> = HashMap::new();
@@ -195,7 +201,8 @@ pub fn read(text: &str, name: &str, tol: f64) -> Result<(Drawing, SvgSource), Cu
         if node.ancestors().any(|a| SKIP.contains(&a.tag_name().name())) {
             continue;
         }
-        let layer = top.iter().position(|t| *t != node && node.ancestors().any(|a| a == *t));
+        let layer =
+            node.ancestors().skip(1).find(|a| a.parent() == Some(root)).and_then(|a| top_index.get(&a.id()).copied());
         let k = elements.len();
         let tag = format!("towpath-{k}");
         // Insert the synthetic id right after "<name"; an existing id is renamed by usvg's view only.
@@ -252,7 +259,7 @@ pub fn read(text: &str, name: &str, tol: f64) -> Result<(Drawing, SvgSource), Cu
     let mut op_layer: Vec<Option<usize>> = Vec::new();
     let mut layer_op: HashMap<Option<usize>, usize> = HashMap::new();
     for e in &elements {
-        if !layer_op.contains_key(&e.layer) {
+        if let std::collections::hash_map::Entry::Vacant(slot) = layer_op.entry(e.layer) {
             let label = match e.layer {
                 Some(l) => {
                     let n = top[l];
@@ -262,12 +269,12 @@ pub fn read(text: &str, name: &str, tol: f64) -> Result<(Drawing, SvgSource), Cu
                 }
                 None => "(root)".to_string(),
             };
-            layer_op.insert(e.layer, op_layer.len());
+            slot.insert(op_layer.len());
             op_layer.push(e.layer);
             drawing.operations.push(label);
         }
     }
-    // Layer order: by document order of the layer (root-level shapes where they first appear).
+    let line_starts: Vec<usize> = std::iter::once(0).chain(text.match_indices('\n').map(|(i, _)| i + 1)).collect();
     let mut piece_element = Vec::new();
     let mut paths: Vec<(usize, Vec<Path>)> = Vec::new();
     collect(tree.root(), &by_tag, &to_user, &mut paths);
@@ -278,7 +285,8 @@ pub fn read(text: &str, name: &str, tol: f64) -> Result<(Drawing, SvgSource), Cu
             continue;
         }
         e.pieces = subpaths.len();
-        let base = e.id.clone().unwrap_or_else(|| format!("{} element {}", pos_of(&doc, e.range.start), k + 1));
+        let base =
+            e.id.clone().unwrap_or_else(|| format!("{} element {}", line_of(&line_starts, e.range.start), k + 1));
         for (j, path) in subpaths.into_iter().enumerate() {
             let id = if j == 0 { base.clone() } else { format!("{base}-{}", j + 1) };
             piece_element.push((k, j));
@@ -289,10 +297,14 @@ pub fn read(text: &str, name: &str, tol: f64) -> Result<(Drawing, SvgSource), Cu
     let mut layer_inverse = HashMap::new();
     let mut layer_keep = HashMap::new();
     let mut layer_open = HashMap::new();
-    let piece_ranges: Vec<std::ops::Range<usize>> = elements.iter().filter(|e| e.pieces > 0).map(|e| e.range.clone()).collect();
+    let mut piece_ranges: Vec<std::ops::Range<usize>> =
+        elements.iter().filter(|e| e.pieces > 0).map(|e| e.range.clone()).collect();
+    piece_ranges.sort_by_key(|r| r.start);
     let mut top_out = Vec::new();
+    let holding: std::collections::HashSet<usize> =
+        elements.iter().filter(|e| e.pieces > 0).filter_map(|e| e.layer).collect();
     for (l, node) in top.iter().enumerate() {
-        let holds = elements.iter().any(|e| e.layer == Some(l) && e.pieces > 0);
+        let holds = holding.contains(&l);
         top_out.push((node.range(), holds));
         if holds {
             let t = parse_transform(node.attribute("transform"));
@@ -352,16 +364,17 @@ fn rename_id_attr(seg: &str) -> String {
     out
 }
 
-/// Ranges of a layer's content that hold no piece (copied as they were).
+/// Ranges of a layer's content that hold no piece (copied as they were); `pieces` sorted by start.
 fn keep_content(node: roxmltree::Node, pieces: &[std::ops::Range<usize>], out: &mut Vec<std::ops::Range<usize>>) {
     for child in node.children() {
         let r = child.range();
-        let holds = pieces.iter().any(|p| p.start >= r.start && p.end <= r.end);
+        let k = pieces.partition_point(|p| p.start < r.start);
+        let holds = pieces.get(k).is_some_and(|p| p.end <= r.end);
         if !holds {
             if child.is_element() || child.is_comment() {
                 out.push(r);
             }
-        } else if child.is_element() && !pieces.contains(&r) {
+        } else if child.is_element() && pieces.get(k) != Some(&r) {
             keep_content(child, pieces, out);
         }
     }
@@ -411,12 +424,20 @@ fn subpaths(data: &usvg::tiny_skia_path::Path, m: &Affine) -> Vec<Path> {
                 let (q, p) = (pt(q), pt(p));
                 let c1 = [at[0] + 2.0 / 3.0 * (q[0] - at[0]), at[1] + 2.0 / 3.0 * (q[1] - at[1])];
                 let c2 = [p[0] + 2.0 / 3.0 * (q[0] - p[0]), p[1] + 2.0 / 3.0 * (q[1] - p[1])];
-                cur.get_or_insert(Path { start: at, segs: Vec::new(), closed: false }).segs.push(Seg::Cubic { c1, c2, to: p });
+                cur.get_or_insert(Path { start: at, segs: Vec::new(), closed: false }).segs.push(Seg::Cubic {
+                    c1,
+                    c2,
+                    to: p,
+                });
                 at = p;
             }
             S::CubicTo(c1, c2, p) => {
                 let (c1, c2, p) = (pt(c1), pt(c2), pt(p));
-                cur.get_or_insert(Path { start: at, segs: Vec::new(), closed: false }).segs.push(Seg::Cubic { c1, c2, to: p });
+                cur.get_or_insert(Path { start: at, segs: Vec::new(), closed: false }).segs.push(Seg::Cubic {
+                    c1,
+                    c2,
+                    to: p,
+                });
                 at = p;
             }
             S::Close => {
@@ -463,7 +484,15 @@ fn path_data(path: &Path, m: &Affine, tol: f64) -> String {
             }
             Seg::Cubic { c1, c2, to } => {
                 let (a, b, c) = (apply(m, c1), apply(m, c2), apply(m, to));
-                d.push_str(&format!("C{} {} {} {} {} {}", num(a[0]), num(a[1]), num(b[0]), num(b[1]), num(c[0]), num(c[1])));
+                d.push_str(&format!(
+                    "C{} {} {} {} {} {}",
+                    num(a[0]),
+                    num(a[1]),
+                    num(b[0]),
+                    num(b[1]),
+                    num(c[0]),
+                    num(c[1])
+                ));
             }
             Seg::Arc { .. } => {
                 let mut f = Vec::new();
@@ -499,7 +528,9 @@ pub fn write(source: &SvgSource, drawing: &Drawing, order: &[Placement]) -> Stri
         let e = &source.elements[k];
         let id = match (&e.id, e.pieces) {
             (Some(id), 1) => format!(" id=\"{}\"", escape(id)),
-            (Some(id), _) => format!(" id=\"{}\"", escape(&if j == 0 { id.clone() } else { format!("{id}-{}", j + 1) })),
+            (Some(id), _) => {
+                format!(" id=\"{}\"", escape(&if j == 0 { id.clone() } else { format!("{id}-{}", j + 1) }))
+            }
             (None, _) => String::new(),
         };
         let attrs = if e.attrs.is_empty() { String::new() } else { format!(" {}", e.attrs) };
@@ -511,13 +542,15 @@ pub fn write(source: &SvgSource, drawing: &Drawing, order: &[Placement]) -> Stri
     let op_of_layer = |l: Option<usize>| source.op_layer.iter().position(|x| *x == l);
     let mut root_done = false;
     let mut cursor = source.root_open_end;
+    let root_pieces: std::collections::HashSet<usize> =
+        source.elements.iter().filter(|e| e.layer.is_none() && e.pieces > 0).map(|e| e.range.start).collect();
     for (l, (range, holds)) in source.top.iter().enumerate() {
         // Whatever lies between top-level elements (whitespace, comments) is copied.
         if range.start >= cursor {
             out.push_str(&text[cursor..range.start]);
         }
         cursor = range.end.max(cursor);
-        let is_root_piece = source.elements.iter().any(|e| e.layer.is_none() && e.pieces > 0 && e.range == *range);
+        let is_root_piece = root_pieces.contains(&range.start);
         if is_root_piece {
             if !root_done {
                 root_done = true;

@@ -93,7 +93,12 @@ fn inside(p: P2, loop_: &Path) -> bool {
 
 /// The regions of one offset level.
 fn regions(shape: &Shape<f64>) -> Vec<Region> {
-    let mut out: Vec<Region> = shape.ccw_plines.iter().filter_map(|p| from_pline(&p.polyline)).map(|outer| Region { outer, holes: Vec::new() }).collect();
+    let mut out: Vec<Region> = shape
+        .ccw_plines
+        .iter()
+        .filter_map(|p| from_pline(&p.polyline))
+        .map(|outer| Region { outer, holes: Vec::new() })
+        .collect();
     let areas: Vec<f64> = out.iter().map(|r| signed_area(&flat(&r.outer)).abs()).collect();
     for h in &shape.cw_plines {
         let Some(hole) = from_pline(&h.polyline) else { continue };

@@ -83,7 +83,11 @@ fn entry_places(cell: &Cell, opts: &MillOptions) -> Vec<Place> {
     let outer = &first.outer;
     let max = opts.max_entries.max(1);
     let n = outer.segs.len();
-    let mut places: Vec<Place> = if n <= max { (0..n).map(|seg| Place { seg, t: 0.0 }).collect() } else { (0..max).map(|k| Place { seg: k * n / max, t: 0.0 }).collect() };
+    let mut places: Vec<Place> = if n <= max {
+        (0..n).map(|seg| Place { seg, t: 0.0 }).collect()
+    } else {
+        (0..max).map(|k| Place { seg: k * n / max, t: 0.0 }).collect()
+    };
     if places.len() < max {
         let room = max - places.len();
         let len = outer.length();
@@ -190,7 +194,9 @@ pub fn plan(part: &Part, opts: &MillOptions) -> Result<Plan, CutError> {
         // Baseline: cells in feature order (a topological order, stable), first vertex.
         let topo = problem.precedence().topological().to_vec();
         let mut done = vec![false; cells.len()];
-        let preds: Vec<Vec<usize>> = (0..cells.len()).map(|t| problem.precedence().predecessors(TaskId(t as u32)).iter().map(|x| x.index()).collect()).collect();
+        let preds: Vec<Vec<usize>> = (0..cells.len())
+            .map(|t| problem.precedence().predecessors(TaskId(t as u32)).iter().map(|x| x.index()).collect())
+            .collect();
         while baseline_steps.len() < cells.len() {
             let next = (0..cells.len()).find(|&t| !done[t] && preds[t].iter().all(|&p| done[p]));
             let t = next.unwrap_or_else(|| topo[baseline_steps.len()].index());
@@ -201,10 +207,17 @@ pub fn plan(part: &Part, opts: &MillOptions) -> Result<Plan, CutError> {
         let mut sopts = opts.solve.clone();
         sopts.initial = Some(baseline_steps.clone());
         let t0 = Instant::now();
-        let report = solve_with(opts.solver, &problem, &sopts, &opts.params).map_err(|e| CutError::Solver(e.to_string()))?;
+        let report =
+            solve_with(opts.solver, &problem, &sopts, &opts.params).map_err(|e| CutError::Solver(e.to_string()))?;
         tp.solve_seconds = t0.elapsed().as_secs_f64();
-        tp.baseline = baseline_steps.iter().map(|s| (s.task.index(), paths[s.task.index()][s.mode as usize].clone())).collect();
-        tp.order = report.solution.steps.iter().map(|s| (s.task.index(), paths[s.task.index()][s.mode as usize].clone())).collect();
+        tp.baseline =
+            baseline_steps.iter().map(|s| (s.task.index(), paths[s.task.index()][s.mode as usize].clone())).collect();
+        tp.order = report
+            .solution
+            .steps
+            .iter()
+            .map(|s| (s.task.index(), paths[s.task.index()][s.mode as usize].clone()))
+            .collect();
         tp.rapid_before = rapid_length(part.origin, &tp.baseline);
         tp.rapid_after = rapid_length(part.origin, &tp.order);
         tools.push(tp);

@@ -48,7 +48,13 @@ fn feed_moves(path: &Path, out: &mut Vec<String>) {
 pub fn gcode(part: &Part, plan: &Plan) -> String {
     let mut out = vec![
         format!("(towpath machine: {})", part.name),
-        format!("({} tools, clearance {}, origin {} {})", plan.tools.len(), fmt(part.clearance), fmt(part.origin[0]), fmt(part.origin[1])),
+        format!(
+            "({} tools, clearance {}, origin {} {})",
+            plan.tools.len(),
+            fmt(part.clearance),
+            fmt(part.origin[0]),
+            fmt(part.origin[1])
+        ),
         if part.units == "inch" || part.units == "in" { "G20".into() } else { "G21".into() },
         "G90 G17".into(),
     ];
@@ -112,7 +118,12 @@ pub fn svg(part: &Part, plan: &Plan) -> String {
     );
     s.push_str("<g id=\"features\" fill=\"none\" stroke=\"#999\">\n");
     for f in &part.features {
-        s.push_str(&format!("<path stroke-width=\"{}\" d=\"{}\"><title>{}</title></path>\n", fmt(sw * 2.0), d_attr(&f.boundary), f.id));
+        s.push_str(&format!(
+            "<path stroke-width=\"{}\" d=\"{}\"><title>{}</title></path>\n",
+            fmt(sw * 2.0),
+            d_attr(&f.boundary),
+            f.id
+        ));
         for i in &f.islands {
             s.push_str(&format!("<path stroke-width=\"{}\" d=\"{}\"/>\n", fmt(sw * 2.0), d_attr(i)));
         }
@@ -121,7 +132,11 @@ pub fn svg(part: &Part, plan: &Plan) -> String {
     for (k, tp) in plan.tools.iter().enumerate() {
         let colour = COLOURS[k % COLOURS.len()];
         let tool = &part.tools[tp.tool];
-        s.push_str(&format!("<g id=\"T{}\" fill=\"none\" stroke=\"{colour}\" stroke-width=\"{}\">\n", tool.number, fmt(sw)));
+        s.push_str(&format!(
+            "<g id=\"T{}\" fill=\"none\" stroke=\"{colour}\" stroke-width=\"{}\">\n",
+            tool.number,
+            fmt(sw)
+        ));
         let mut at = part.origin;
         for (c, cp) in &tp.order {
             let e = cp.entry();
@@ -137,7 +152,14 @@ pub fn svg(part: &Part, plan: &Plan) -> String {
             for m in &cp.moves {
                 s.push_str(&format!("<path d=\"{}\"/>\n", d_attr(m)));
             }
-            s.push_str(&format!("<circle cx=\"{}\" cy=\"{}\" r=\"{}\" fill=\"{colour}\"><title>T{} cell {}</title></circle>\n", fmt(e[0]), fmt(-e[1]), fmt(sw * 3.0), tool.number, tp.cells[*c].id));
+            s.push_str(&format!(
+                "<circle cx=\"{}\" cy=\"{}\" r=\"{}\" fill=\"{colour}\"><title>T{} cell {}</title></circle>\n",
+                fmt(e[0]),
+                fmt(-e[1]),
+                fmt(sw * 3.0),
+                tool.number,
+                tp.cells[*c].id
+            ));
             at = cp.exit();
         }
         s.push_str(&format!(

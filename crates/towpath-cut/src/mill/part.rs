@@ -177,7 +177,10 @@ fn to_loop(l: &LoopJson, what: &str, ccw: bool) -> Result<Path, CutError> {
         f
     };
     if let Some((i, j)) = self_crossing(&flat) {
-        return Err(CutError::Part(format!("{what}: the boundary crosses itself (near points {:?} and {:?})", flat[i], flat[j])));
+        return Err(CutError::Part(format!(
+            "{what}: the boundary crosses itself (near points {:?} and {:?})",
+            flat[i], flat[j]
+        )));
     }
     let area = crate::geom::signed_area(&flat);
     if area == 0.0 {
@@ -188,7 +191,8 @@ fn to_loop(l: &LoopJson, what: &str, ccw: bool) -> Result<Path, CutError> {
 
 /// Reads and validates a part file; `name` is used in messages.
 pub fn read_part(text: &str, name: &str) -> Result<Part, CutError> {
-    let p: PartJson = serde_json::from_str(text).map_err(|e| CutError::Input(format!("{name}:{}:{}: {e}", e.line(), e.column())))?;
+    let p: PartJson =
+        serde_json::from_str(text).map_err(|e| CutError::Input(format!("{name}:{}:{}: {e}", e.line(), e.column())))?;
     if p.format != FORMAT {
         return Err(CutError::Input(format!("{name}: format {:?} is not {FORMAT:?}", p.format)));
     }
@@ -213,7 +217,9 @@ pub fn read_part(text: &str, name: &str) -> Result<Part, CutError> {
             .collect::<Result<Vec<_>, _>>()?;
         let parent = match &f.parent {
             None => None,
-            Some(pid) => Some(*ids.get(pid).ok_or_else(|| CutError::Part(format!("{what}: parent {pid:?} is no feature's id")))?),
+            Some(pid) => Some(
+                *ids.get(pid).ok_or_else(|| CutError::Part(format!("{what}: parent {pid:?} is no feature's id")))?,
+            ),
         };
         features.push(Feature { id: f.id.clone(), boundary, islands, depth: f.depth, parent });
     }
@@ -224,7 +230,10 @@ pub fn read_part(text: &str, name: &str) -> Result<Part, CutError> {
         while let Some(k) = at {
             steps += 1;
             if k == i || steps > features.len() {
-                return Err(CutError::Part(format!("{name}: features[{i}] (id {:?}) is its own ancestor", features[i].id)));
+                return Err(CutError::Part(format!(
+                    "{name}: features[{i}] (id {:?}) is its own ancestor",
+                    features[i].id
+                )));
             }
             at = features[k].parent;
         }
@@ -255,7 +264,9 @@ pub fn read_part(text: &str, name: &str) -> Result<Part, CutError> {
         }
         let mut fs = Vec::new();
         for fid in &t.features {
-            fs.push(*ids.get(fid).ok_or_else(|| CutError::Part(format!("{what}: feature {fid:?} is no feature's id")))?);
+            fs.push(
+                *ids.get(fid).ok_or_else(|| CutError::Part(format!("{what}: feature {fid:?} is no feature's id")))?,
+            );
         }
         tools.push(Tool { number: t.number, radius: t.radius, step_over, feed, plunge_feed, spindle, features: fs });
     }

@@ -83,7 +83,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         files.output("report", r)?;
     }
     let name = args.part.display().to_string();
-    let text = std::fs::read_to_string(&args.part).with_context(|| format!("reading {name}")).map_err(exit::bad_input)?;
+    let text =
+        std::fs::read_to_string(&args.part).with_context(|| format!("reading {name}")).map_err(exit::bad_input)?;
     let mut part = read_part(&text, &name).map_err(exit::bad_input)?;
     if let Some(s) = args.step_over {
         for t in &mut part.tools {
@@ -111,7 +112,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(_) if args.time_limit == 2.0 => None,
         _ => Some(crate::cmd::solver_args::time_limit(args.time_limit)?),
     };
-    let mut solve = SolveOptions { time_limit, iterations: args.iterations, seed: args.seed, ..SolveOptions::default() };
+    let mut solve =
+        SolveOptions { time_limit, iterations: args.iterations, seed: args.seed, ..SolveOptions::default() };
     if let Some(t) = args.threads {
         solve.threads = t.max(1);
     }
@@ -125,7 +127,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         params: args.solver.params(),
     };
     let p = plan(&part, &opts).map_err(|e| match e {
-        towpath_cut::CutError::Solver(s) => exit::bad_input(anyhow::anyhow!("solver {}: {s}{}", opts.solver, if opts.solver == towpath_baselines::SolverName::Towpath { "" } else { " (--solver towpath takes every valid problem)" })),
+        towpath_cut::CutError::Solver(s) => exit::bad_input(anyhow::anyhow!(
+            "solver {}: {s}{}",
+            opts.solver,
+            if opts.solver == towpath_baselines::SolverName::Towpath {
+                ""
+            } else {
+                " (--solver towpath takes every valid problem)"
+            }
+        )),
         e => exit::bad_input(e),
     })?;
     let _ = refusal;

@@ -108,7 +108,7 @@ pub struct Args {
     /// Flattening and "touching" tolerance in drawing units.
     #[arg(long, default_value_t = 1e-3)]
     pub tolerance: f64,
-    /// Solver time limit in seconds (default 1 + 0.0001 s per piece, at most 8).
+    /// Solver time limit in seconds (default 1 + 0.0003 s per piece, at most 8).
     #[arg(long)]
     pub time_limit: Option<f64>,
     /// Work budget (improvement kicks); without --time-limit the answer then depends only on
@@ -132,9 +132,11 @@ fn parse_start(s: &str) -> anyhow::Result<Option<[f64; 2]>> {
     if s.eq_ignore_ascii_case("none") {
         return Ok(None);
     }
-    let v: Vec<f64> = s.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| {
-        exit::bad_input(anyhow::anyhow!("--start {s:?}: give X,Y (two numbers) or none"))
-    })?;
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| exit::bad_input(anyhow::anyhow!("--start {s:?}: give X,Y (two numbers) or none")))?;
     match v.as_slice() {
         [x, y] if x.is_finite() && y.is_finite() => Ok(Some([*x, *y])),
         _ => Err(exit::bad_input(anyhow::anyhow!("--start {s:?}: give X,Y (two numbers) or none"))),
@@ -143,7 +145,9 @@ fn parse_start(s: &str) -> anyhow::Result<Option<[f64; 2]>> {
 
 fn positive(name: &str, v: Option<f64>) -> anyhow::Result<()> {
     match v {
-        Some(x) if !(x > 0.0 && x.is_finite()) => Err(exit::bad_input(anyhow::anyhow!("{name} {x}: give a positive number"))),
+        Some(x) if !(x > 0.0 && x.is_finite()) => {
+            Err(exit::bad_input(anyhow::anyhow!("{name} {x}: give a positive number")))
+        }
         _ => Ok(()),
     }
 }
@@ -178,9 +182,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let time_limit = match (args.time_limit, args.iterations) {
         (Some(t), _) => Some(crate::cmd::solver_args::time_limit(t)?),
         (None, Some(_)) => None,
-        (None, None) => Some(std::time::Duration::from_secs_f64((1.0 + 0.0001 * n as f64).min(8.0))),
+        (None, None) => Some(std::time::Duration::from_secs_f64((1.0 + 0.0003 * n as f64).min(8.0))),
     };
-    let mut solve = SolveOptions { time_limit, iterations: args.iterations, seed: args.seed, ..SolveOptions::default() };
+    let mut solve =
+        SolveOptions { time_limit, iterations: args.iterations, seed: args.seed, ..SolveOptions::default() };
     if let Some(t) = args.threads {
         solve.threads = t.max(1);
     }
@@ -253,7 +258,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         });
         outln!("{v}");
     } else {
-        let saved = if report.travel_before > 0.0 { 100.0 * (1.0 - report.travel_after / report.travel_before) } else { 0.0 };
+        let saved =
+            if report.travel_before > 0.0 { 100.0 * (1.0 - report.travel_after / report.travel_before) } else { 0.0 };
         outln!("towpath order: {name}");
         outln!("  pieces              : {n} ({closed} closed, {} operations)", drawing.operations.len());
         outln!("  rapid travel before : {:>14.3}", report.travel_before);

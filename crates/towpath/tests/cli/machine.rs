@@ -23,7 +23,17 @@ fn machines_a_part_and_the_gcode_keeps_the_hierarchy() {
     let nc = dir.join("part.nc");
     let html = dir.join("part.html");
     let o = towpath_out(&[
-        "machine", part.to_str().unwrap(), "-o", nc.to_str().unwrap(), "--report", html.to_str().unwrap(), "--iterations", "100", "--threads", "1", "--json",
+        "machine",
+        part.to_str().unwrap(),
+        "-o",
+        nc.to_str().unwrap(),
+        "--report",
+        html.to_str().unwrap(),
+        "--iterations",
+        "100",
+        "--threads",
+        "1",
+        "--json",
     ]);
     let v = json_of(&o);
     let g = std::fs::read_to_string(&nc).unwrap();
@@ -32,21 +42,38 @@ fn machines_a_part_and_the_gcode_keeps_the_hierarchy() {
     let tools = v["tools"].as_array().unwrap();
     assert_eq!(tools.len(), 2);
     // One plunge per cell, per tool, in the order reported; parents before children.
-    let cells: Vec<String> = g.lines().filter_map(|l| l.strip_prefix("(cell ").map(|s| s.trim_end_matches(')').to_string())).collect();
-    let reported: Vec<String> = tools.iter().flat_map(|t| t["order"].as_array().unwrap().iter().map(|c| c.as_str().unwrap().to_string())).collect();
+    let cells: Vec<String> =
+        g.lines().filter_map(|l| l.strip_prefix("(cell ").map(|s| s.trim_end_matches(')').to_string())).collect();
+    let reported: Vec<String> = tools
+        .iter()
+        .flat_map(|t| t["order"].as_array().unwrap().iter().map(|c| c.as_str().unwrap().to_string()))
+        .collect();
     assert_eq!(cells, reported);
     let plunges = g.lines().filter(|l| l.starts_with("G1 Z")).count();
     assert_eq!(plunges, cells.len());
     let t1: Vec<&str> = tools[0]["order"].as_array().unwrap().iter().map(|c| c.as_str().unwrap()).collect();
     let first_child = t1.iter().position(|c| !c.starts_with("face")).unwrap();
-    assert!(t1[..first_child].iter().all(|c| c.starts_with("face")) && t1[first_child..].iter().all(|c| !c.starts_with("face")));
+    assert!(
+        t1[..first_child].iter().all(|c| c.starts_with("face"))
+            && t1[first_child..].iter().all(|c| !c.starts_with("face"))
+    );
     // The dumbbell splits for T1: its split cell comes before its two halves.
     let db: Vec<&&str> = t1.iter().filter(|c| c.starts_with("dumbbell")).collect();
     assert_eq!(db.len(), 3);
     assert_eq!(*db[0], "dumbbella");
     assert!(v["rapid_after"].as_f64().unwrap() <= v["rapid_before"].as_f64().unwrap() + 1e-9);
     // Castelino's transformation plans the same part legally.
-    let o = towpath_out(&["machine", part.to_str().unwrap(), "--solver", "castelino", "--time-limit", "1", "--threads", "1", "--json"]);
+    let o = towpath_out(&[
+        "machine",
+        part.to_str().unwrap(),
+        "--solver",
+        "castelino",
+        "--time-limit",
+        "1",
+        "--threads",
+        "1",
+        "--json",
+    ]);
     let c = json_of(&o);
     assert_eq!(c["solver"], "castelino");
     assert_eq!(c["tools"][0]["cells"], v["tools"][0]["cells"]);
@@ -60,7 +87,11 @@ fn bad_parts_are_refused() {
     let (code, _, err) = run(towpath().args(["machine", part.to_str().unwrap()]));
     assert_eq!(code, 2);
     assert!(err.contains("tools[0] (T1)") && err.contains("radius"), "{err}");
-    std::fs::write(&part, PART.replace("[[140,10],[190,10],[190,90],[140,90]]", "[[140,10],[190,90],[190,10],[140,90]]")).unwrap();
+    std::fs::write(
+        &part,
+        PART.replace("[[140,10],[190,10],[190,90],[140,90]]", "[[140,10],[190,90],[190,10],[140,90]]"),
+    )
+    .unwrap();
     let (code, _, err) = run(towpath().args(["machine", part.to_str().unwrap()]));
     assert_eq!(code, 2);
     assert!(err.contains("\"ring\"") && err.contains("crosses itself"), "{err}");

@@ -27,14 +27,21 @@ fn check_output(format: Format, input: &str, output: &str, start: Option<[f64; 2
     let mut placements = Vec::new();
     for p in &back.pieces {
         let i = (0..d.pieces.len())
-            .filter(|&i| !used[i] && d.pieces[i].path.closed == p.path.closed && (d.pieces[i].path.length() - p.path.length()).abs() < 1e-3)
+            .filter(|&i| {
+                !used[i]
+                    && d.pieces[i].path.closed == p.path.closed
+                    && (d.pieces[i].path.length() - p.path.length()).abs() < 1e-3
+            })
             .min_by(|&a, &b| {
-                let f = |i: usize| dist(d.pieces[i].path.start, p.path.start).min(dist(d.pieces[i].path.end(), p.path.start));
+                let f = |i: usize| {
+                    dist(d.pieces[i].path.start, p.path.start).min(dist(d.pieces[i].path.end(), p.path.start))
+                };
                 f(a).total_cmp(&f(b))
             })
             .expect("a matching input piece");
         used[i] = true;
-        let reversed = !p.path.closed && dist(p.path.start, d.pieces[i].path.end()) < dist(p.path.start, d.pieces[i].path.start);
+        let reversed =
+            !p.path.closed && dist(p.path.start, d.pieces[i].path.end()) < dist(p.path.start, d.pieces[i].path.start);
         placements.push(Placement { piece: i, path: p.path.clone(), reversed, lead_in: None });
     }
     let rules = Rules { inner_first: true, mix_operations: false, reverse: true, tolerance: 1e-2, start };
@@ -49,7 +56,17 @@ fn orders_an_svg_holes_first_and_the_file_verifies() {
     let input = dir.join("in.svg");
     std::fs::write(&input, SVG).unwrap();
     let out = dir.join("out.svg");
-    let o = towpath_out(&["order", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--iterations", "50", "--threads", "1", "--json"]);
+    let o = towpath_out(&[
+        "order",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--iterations",
+        "50",
+        "--threads",
+        "1",
+        "--json",
+    ]);
     let v = json_of(&o);
     let written = std::fs::read_to_string(&out).unwrap();
     let ids = check_output(Format::Svg, SVG, &written, Some([0.0, 0.0]));
@@ -79,7 +96,19 @@ fn gcode_with_lead_ins_and_merge() {
     std::fs::write(&input, prog).unwrap();
     let out = dir.join("out.nc");
     let o = towpath_out(&[
-        "order", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--iterations", "50", "--threads", "1", "--lead-in", "2", "--merge", "0.01", "--json",
+        "order",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--iterations",
+        "50",
+        "--threads",
+        "1",
+        "--lead-in",
+        "2",
+        "--merge",
+        "0.01",
+        "--json",
     ]);
     let v = json_of(&o);
     assert_eq!(v["pieces"], 4);
@@ -92,7 +121,7 @@ fn gcode_with_lead_ins_and_merge() {
     // Lead-ins: the rapid before the outer square ends 2 mm off its contour, outside it.
     let rapids: Vec<&str> = written.lines().filter(|l| l.starts_with("G0 X")).collect();
     assert_eq!(rapids.len(), 4, "{written}"); // two squares, the merged strokes once... and home
-    // Merged strokes: the second follows the first without a rapid in between.
+                                              // Merged strokes: the second follows the first without a rapid in between.
     let a = written.find("X70 Y0").unwrap();
     let b = written[a..].find("X80 Y0").map(|k| a + k).or_else(|| written.find("X80 Y0")).unwrap();
     let between = &written[a.min(b)..a.max(b)];
@@ -105,7 +134,10 @@ fn dxf_round_trip_through_the_binary() {
     let mut dr = dxf::Drawing::new();
     dr.header.version = dxf::enums::AcadVersion::R2000;
     for (c, r) in [((50.0, 50.0), 30.0), ((50.0, 50.0), 10.0), ((150.0, 50.0), 20.0)] {
-        let mut e = dxf::entities::Entity::new(dxf::entities::EntityType::Circle(dxf::entities::Circle::new(dxf::Point::new(c.0, c.1, 0.0), r)));
+        let mut e = dxf::entities::Entity::new(dxf::entities::EntityType::Circle(dxf::entities::Circle::new(
+            dxf::Point::new(c.0, c.1, 0.0),
+            r,
+        )));
         e.common.layer = "CUT".into();
         dr.add_entity(e);
     }
@@ -115,7 +147,17 @@ fn dxf_round_trip_through_the_binary() {
     let input = dir.join("in.dxf");
     std::fs::write(&input, &text).unwrap();
     let out = dir.join("out.dxf");
-    let o = towpath_out(&["order", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--iterations", "20", "--threads", "1", "--json"]);
+    let o = towpath_out(&[
+        "order",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--iterations",
+        "20",
+        "--threads",
+        "1",
+        "--json",
+    ]);
     let _ = json_of(&o);
     let written = std::fs::read_to_string(&out).unwrap();
     check_output(Format::Dxf, &text, &written, Some([0.0, 0.0]));
@@ -130,7 +172,11 @@ fn refused_input_names_file_and_line() {
     assert_eq!(code, 2);
     assert!(err.contains("bad.nc:2:") && err.contains("G91"), "{err}");
     let j = dir.join("bad.json");
-    std::fs::write(&j, r#"{"format": "towpath-cut/1", "pieces": [{"id": "a", "closed": true, "points": [[0,0],[1,0]]}]}"#).unwrap();
+    std::fs::write(
+        &j,
+        r#"{"format": "towpath-cut/1", "pieces": [{"id": "a", "closed": true, "points": [[0,0],[1,0]]}]}"#,
+    )
+    .unwrap();
     let (code, _, err) = run(towpath().args(["order", j.to_str().unwrap()]));
     assert_eq!(code, 2);
     assert!(err.contains("bad.json") && err.contains("pieces[0]") && err.contains("closed"), "{err}");
