@@ -5,6 +5,8 @@ mod afp;
 mod common;
 mod convert;
 mod layup;
+mod machine;
+mod order;
 mod outputs_and_pipes;
 mod route;
 mod solve;
