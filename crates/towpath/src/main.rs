@@ -36,6 +36,8 @@ enum Command {
     Route(cmd::route::Args),
     /// Run a benchmark and print (or write into BENCHMARKS.md) its tables.
     Bench(cmd::bench::Args),
+    /// Start the web application: machine set-up, programs in 3D, solves with live progress, layup.
+    Serve(cmd::serve::Args),
 }
 
 fn main() {
@@ -49,6 +51,7 @@ fn main() {
         Command::Verify(args) => cmd::verify::run(args),
         Command::Route(args) => cmd::route::run(args),
         Command::Bench(args) => cmd::bench::run(args),
+        Command::Serve(args) => cmd::serve::run(args),
     };
     std::process::exit(exit::report(result));
 }

@@ -8,6 +8,7 @@ pub mod demo;
 pub mod layup;
 pub mod optimize;
 pub mod route;
+pub mod serve;
 pub mod solve;
 pub mod solver_args;
 pub mod verify;
