@@ -2,7 +2,7 @@
 // surface view. Plain modules, no framework: the page is a tool, not a site.
 
 import { getJson, sendJson, sendBody, getBlob } from './api.js';
-import { View, ProgramLayers, KIND } from './viewer.js';
+import { View, ProgramLayers, KIND, softwareGL } from './viewer.js';
 import { categorical, css, rampCss } from './colors.js';
 import { initMachine } from './machine.js';
 import { initSurface } from './surface.js';
@@ -28,6 +28,8 @@ for (const b of document.querySelectorAll('.tab')) {
 
 // ---------------------------------------------------------------- program view
 const view = new View($('viewport'));
+app.view = view;
+app.softwareGL = softwareGL;
 
 function showError(el, e) {
   if (!e) { el.hidden = true; el.textContent = ''; return; }
@@ -113,7 +115,7 @@ function renderPlies() {
     const row = document.createElement('label');
     row.className = 'ply';
     row.innerHTML = `<input type="checkbox" checked data-ply="${i}"><span class="dot" style="background:${css(categorical(i))}"></span>
-      <span title="${p.label}">${p.name === p.label ? p.label : `${p.name} · ${p.label}`}</span>
+      <span title="${p.label}${p.line ? ` (line ${p.line})` : ''}">${p.label}</span>
       <span class="n">${p.courses.length} · ${fmt(p.length / 1000, 1)} m</span>`;
     row.querySelector('input').addEventListener('change', (e) => setPly(i, e.target.checked));
     list.appendChild(row);
@@ -170,8 +172,11 @@ async function openProgram(id) {
     setupScrub();
     view.fit(layers.box);
     await new Promise((r) => { view.onFrame = r; view.request(); });
+    // Wait until the frame is really drawn (the GPU may still be working when render returns).
+    const gl = view.renderer.getContext();
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
     const t2 = performance.now();
-    app.timing = { id, fetch_ms: t1 - t0, first_frame_ms: t2 - t0, bytes: blob.bytes, segments: layers.segments, draw_calls: layers.layers.length };
+    app.timing = { id, fetch_ms: t1 - t0, first_frame_ms: t2 - t0, bytes: blob.bytes, segments: layers.segments, drawn: layers.drawn, draw_calls: layers.layers.length, software_gl: softwareGL };
     $('viewport').dataset.firstFrameMs = String(Math.round(t2 - t0));
     $('viewport').dataset.program = id;
     // The latest result of this program, if one was kept.

@@ -10,10 +10,26 @@ import { categorical, ramp } from './colors.js';
 export const KIND = { LAYUP: 0, APPROACH: 1, TRANSIT: 2, RAPID: 3 };
 const MODE = { fixed: 0, ply: 1, order: 2, feed: 3 };
 
+/** True when WebGL runs in software (SwiftShader, llvmpipe): multisampling is then the most
+ *  expensive part of a frame, so the views draw without it there. */
+export const softwareGL = (() => {
+  try {
+    const gl = document.createElement('canvas').getContext('webgl2') || document.createElement('canvas').getContext('webgl');
+    if (!gl) return false;
+    const ext = gl.getExtension('WEBGL_debug_renderer_info');
+    const name = String(gl.getParameter(ext ? ext.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+    const lose = gl.getExtension('WEBGL_lose_context');
+    if (lose) lose.loseContext();
+    return /swiftshader|llvmpipe|softpipe|software/i.test(name);
+  } catch {
+    return false;
+  }
+})();
+
 export class View {
   constructor(el) {
     this.el = el;
-    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    this.renderer = new THREE.WebGLRenderer({ antialias: !softwareGL, preserveDrawingBuffer: true });
     this.renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
     this.renderer.setClearColor(0x1b2129);
     el.appendChild(this.renderer.domElement);
@@ -60,7 +76,7 @@ export class View {
     if (!box || box.isEmpty()) return;
     const c = box.getCenter(new THREE.Vector3());
     const r = Math.max(1, box.getSize(new THREE.Vector3()).length() / 2);
-    const d = r / Math.sin((this.camera.fov * Math.PI) / 360) * 1.05;
+    const d = (r / Math.sin((this.camera.fov * Math.PI) / 360)) * 0.8;
     const dir = top ? new THREE.Vector3(0, -0.001, 1) : new THREE.Vector3(0.55, -0.95, 0.75);
     dir.normalize();
     this.camera.position.copy(c).addScaledVector(dir, d);
@@ -189,9 +205,27 @@ export class ProgramLayers {
       const aOrder = new Float32Array(m * 2), aFeed = new Float32Array(m * 2), aDist = new Float32Array(m * 2);
       const seg = new Uint32Array(m);
       let j = 0;
+      let last = -1; // the previous segment of this kind, if it may be extended
       for (let i = 0; i < n; i++) {
         if (kind[i] !== k) continue;
         const a = from[i] * 3, b = to[i] * 3;
+        // A move that continues the previous one in a straight line (same course, same feed)
+        // extends it: straight courses become one segment, whatever their point count.
+        if (last >= 0 && from[i] === to[last] && course[i] === course[last] && feed[i] === feed[last]) {
+          const q = j - 1;
+          const ux = pos[q * 6 + 3] - pos[q * 6], uy = pos[q * 6 + 4] - pos[q * 6 + 1], uz = pos[q * 6 + 5] - pos[q * 6 + 2];
+          const vx = P[b] - P[a], vy = P[b + 1] - P[a + 1], vz = P[b + 2] - P[a + 2];
+          const cx = uy * vz - uz * vy, cy = uz * vx - ux * vz, cz = ux * vy - uy * vx;
+          const dot = ux * vx + uy * vy + uz * vz;
+          const uu = ux * ux + uy * uy + uz * uz, vv = vx * vx + vy * vy + vz * vz;
+          if (dot > 0 && cx * cx + cy * cy + cz * cz <= 1e-12 * uu * vv) {
+            pos[q * 6 + 3] = P[b]; pos[q * 6 + 4] = P[b + 1]; pos[q * 6 + 5] = P[b + 2];
+            aDist[q * 2 + 1] += Math.sqrt(vv);
+            last = i;
+            continue;
+          }
+        }
+        last = i;
         pos[j * 6] = P[a]; pos[j * 6 + 1] = P[a + 1]; pos[j * 6 + 2] = P[a + 2];
         pos[j * 6 + 3] = P[b]; pos[j * 6 + 4] = P[b + 1]; pos[j * 6 + 5] = P[b + 2];
         const c = course[i];
@@ -205,12 +239,14 @@ export class ProgramLayers {
         j++;
       }
       const g = new THREE.BufferGeometry();
-      g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-      g.setAttribute('aPly', new THREE.BufferAttribute(aPly, 1));
-      g.setAttribute('aSeq', new THREE.BufferAttribute(aSeq, 1));
-      g.setAttribute('aOrder', new THREE.BufferAttribute(aOrder, 1));
-      g.setAttribute('aFeed', new THREE.BufferAttribute(aFeed, 1));
-      g.setAttribute('aDist', new THREE.BufferAttribute(aDist, 1));
+      this.drawn = (this.drawn || 0) + j;
+      const used = (arr, w) => arr.subarray(0, j * w);
+      g.setAttribute('position', new THREE.BufferAttribute(used(pos, 6), 3));
+      g.setAttribute('aPly', new THREE.BufferAttribute(used(aPly, 2), 1));
+      g.setAttribute('aSeq', new THREE.BufferAttribute(used(aSeq, 2), 1));
+      g.setAttribute('aOrder', new THREE.BufferAttribute(used(aOrder, 2), 1));
+      g.setAttribute('aFeed', new THREE.BufferAttribute(used(aFeed, 2), 1));
+      g.setAttribute('aDist', new THREE.BufferAttribute(used(aDist, 2), 1));
       g.computeBoundingSphere();
       g.computeBoundingBox();
       if (k === KIND.LAYUP && m > 0) this.box.union(g.boundingBox);

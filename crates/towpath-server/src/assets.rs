@@ -25,14 +25,16 @@ fn content_type(path: &str) -> &'static str {
 pub async fn serve(uri: Uri) -> Response {
     let path = uri.path().trim_start_matches('/');
     let path = if path.is_empty() { "index.html" } else { path };
-    match Assets::get(path) {
-        Some(f) => (
-            [(header::CONTENT_TYPE, content_type(path)), (header::CACHE_CONTROL, "no-cache")],
-            f.data.into_owned(),
-        )
-            .into_response(),
-        None => (StatusCode::NOT_FOUND, "not found").into_response(),
-    }
+    let Some(f) = Assets::get(path) else {
+        return (StatusCode::NOT_FOUND, "not found").into_response();
+    };
+    // For front-end work: `TOWPATH_WEB_DIR=crates/towpath-server/assets` serves the same names
+    // (only names the binary embeds) from that folder, so a rebuilt bundle shows without
+    // rebuilding the binary.
+    let body = std::env::var_os("TOWPATH_WEB_DIR")
+        .and_then(|dir| std::fs::read(std::path::Path::new(&dir).join(path)).ok())
+        .unwrap_or_else(|| f.data.into_owned());
+    ([(header::CONTENT_TYPE, content_type(path)), (header::CACHE_CONTROL, "no-cache")], body).into_response()
 }
 
 /// Names of the embedded files.

@@ -11,7 +11,6 @@ use axum::response::sse::{Event, KeepAlive, Sse};
 use axum::response::Response;
 use axum::Json;
 use futures_util::stream::{self, Stream};
-use serde::Deserialize;
 use serde_json::{json, Value};
 
 use crate::adapt::{layup, nc};
@@ -62,11 +61,23 @@ pub async fn events(
     Ok(Sse::new(stream).keep_alive(KeepAlive::default()))
 }
 
-#[derive(Deserialize)]
+/// The optimize request: `program` and the fields of [`nc::OptimizeRequest`] (unknown fields
+/// refused, which `serde(flatten)` would not do).
 pub struct OptimizeBody {
     program: String,
-    #[serde(flatten)]
     request: nc::OptimizeRequest,
+}
+
+impl OptimizeBody {
+    fn from_value(v: &Value) -> Result<OptimizeBody, ApiError> {
+        let mut obj = v.as_object().cloned().ok_or_else(|| ApiError::bad("request: a JSON object"))?;
+        let program = match obj.remove("program") {
+            Some(Value::String(p)) => p,
+            _ => return Err(ApiError::bad("program: give the id of the program to optimize")),
+        };
+        let request = serde_json::from_value(Value::Object(obj)).map_err(|e| ApiError::bad(format!("request: {e}")))?;
+        Ok(OptimizeBody { program, request })
+    }
 }
 
 /// `POST /api/jobs/optimize`: `{"program": id, cost, bidirectional, precedence, ...}`.
@@ -75,7 +86,7 @@ pub async fn optimize(
     body: Result<Json<Value>, axum::extract::rejection::JsonRejection>,
 ) -> ApiResult<(StatusCode, Json<JobView>)> {
     let Json(raw) = body.map_err(|e| ApiError::bad(format!("request: {}", e.body_text())))?;
-    let b: OptimizeBody = serde_json::from_value(raw.clone()).map_err(|e| ApiError::bad(format!("request: {e}")))?;
+    let b = OptimizeBody::from_value(&raw)?;
     b.request.validate()?;
     if let Some(t) = b.request.time_limit {
         if t > s.config.max_time_limit {

@@ -33,6 +33,7 @@ pub async fn status(State(s): State<Arc<AppState>>) -> Json<Value> {
             "job_wall_limit": c.job_wall_limit,
         },
         "panel": crate::state::PANEL_ID,
+        "panel_ready": s.read().programs.get(crate::state::PANEL_ID).is_some_and(|p| p.geometry.get().is_some()),
     }))
 }
 
