@@ -366,7 +366,7 @@ async function showResult(v, fresh) {
   const verdict = $('verdict');
   verdict.className = `verdict${r.verified ? '' : ' bad'}`;
   verdict.textContent = r.fell_back ? `${r.verdict} · nothing cheaper found: the program is unchanged` : r.verdict;
-  const rows = r.savings.map((s) => `<tr><td>${s.cost === r.cost ? '<b>' + s.cost + '</b>' : s.cost} <span class="muted">${s.unit}</span></td>
+  const rows = r.savings.map((s) => `<tr title="${s.unit}"><td>${s.cost === r.cost ? '<b>' + s.cost + '</b>' : s.cost}</td>
     <td>${fmt(s.off_before, 1)}</td><td>${fmt(s.off_after, 1)}</td><td class="${s.off_saved_percent > 0 ? 'good' : ''}">${fmt(s.off_saved_percent, 1)} %</td><td>${fmt(s.total_saved_percent, 1)} %</td></tr>`);
   $('savings').innerHTML = `<tr><th>off-part</th><th>before</th><th>after</th><th>saved</th><th>total</th></tr>${rows.join('')}`;
   $('per-ply').innerHTML = `<tr><th>ply</th><th>courses</th><th>before</th><th>after</th><th>saved</th></tr>` +

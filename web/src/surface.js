@@ -61,7 +61,7 @@ function drawTows() {
     if (mode === 'radius') continue;
     if (v !== null && Math.abs(v) > range) range = Math.abs(v);
   }
-  if (mode === 'radius') range = courses.summary.quality.min_steering_radius_limit || 1000;
+  if (mode === 'radius') range = courses.summary.min_steering_radius_limit || 1000;
   const pos = [], col = [];
   const lift = w * 0.05;
   for (const c of courses.courses) {
@@ -108,7 +108,7 @@ async function showResult(v) {
   drawTows();
   g.computeBoundingBox();
   view.fit(g.boundingBox);
-  const q = doc.summary.quality;
+  const q = doc.summary;
   const s = $('s-summary');
   s.hidden = false;
   s.innerHTML = `<span class="lbl">Ply</span>

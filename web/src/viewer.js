@@ -76,7 +76,7 @@ export class View {
     if (!box || box.isEmpty()) return;
     const c = box.getCenter(new THREE.Vector3());
     const r = Math.max(1, box.getSize(new THREE.Vector3()).length() / 2);
-    const d = (r / Math.sin((this.camera.fov * Math.PI) / 360)) * 0.8;
+    const d = (r / Math.sin((this.camera.fov * Math.PI) / 360)) * 0.95;
     const dir = top ? new THREE.Vector3(0, -0.001, 1) : new THREE.Vector3(0.55, -0.95, 0.75);
     dir.normalize();
     this.camera.position.copy(c).addScaledVector(dir, d);
@@ -259,6 +259,9 @@ export class ProgramLayers {
         },
       });
       const obj = new THREE.LineSegments(g, mat);
+      // Laid courses are drawn last and never hidden by the transit above them.
+      obj.renderOrder = k === KIND.LAYUP ? 10 : 3 - k;
+      if (k === KIND.LAYUP) mat.depthTest = false;
       obj.userData = { kind: k, seg, layers: this };
       obj.frustumCulled = false;
       this.layers.push(obj);
@@ -274,8 +277,9 @@ export class ProgramLayers {
     app.material.uniforms.uColor.value.set(0x7f90a3);
     app.material.uniforms.uOpacity.value = 0.75;
     tr.material.uniforms.uColor.value.copy(transit);
+    tr.material.uniforms.uOpacity.value = 0.8;
     ra.material.uniforms.uColor.value.copy(transit);
-    ra.material.uniforms.uOpacity.value = 0.85;
+    ra.material.uniforms.uOpacity.value = 0.6;
     const size = this.box.getSize(new THREE.Vector3()).length();
     ra.material.uniforms.uDash.value = Math.max(1, size / 150);
     lay.material.uniforms.uColor.value.set(0xdfe6ee);

@@ -221,9 +221,7 @@ impl Jobs {
 
     /// A job by id.
     pub fn get(&self, id: &str) -> Result<Arc<Job>, ApiError> {
-        number(id)
-            .and_then(|n| self.map().get(&n).cloned())
-            .ok_or_else(|| ApiError::NotFound(format!("no job {id:?}")))
+        number(id).and_then(|n| self.map().get(&n).cloned()).ok_or_else(|| ApiError::NotFound(format!("no job {id:?}")))
     }
 
     /// Reloads the jobs kept in the workspace; a job the last server left unfinished is marked

@@ -198,11 +198,7 @@ impl AppState {
         }
         store.dialects.insert(
             am::REFERENCE_DIALECT.into(),
-            DialectEntry {
-                dialect: am::DialectModel::default(),
-                text: am::reference_dialect_toml(),
-                builtin: true,
-            },
+            DialectEntry { dialect: am::DialectModel::default(), text: am::reference_dialect_toml(), builtin: true },
         );
         for d in nc::demo_parts() {
             let id = format!("demo-{}", d.name);
@@ -307,7 +303,8 @@ fn load_workspace(ws: &Workspace, store: &mut Store) {
     }
     for f in ws.list(Kind::Dialects) {
         let Some(name) = strip(&f, ".toml") else { continue };
-        let text = String::from_utf8_lossy(&ws.read(Kind::Dialects, &f).ok().flatten().unwrap_or_default()).into_owned();
+        let text =
+            String::from_utf8_lossy(&ws.read(Kind::Dialects, &f).ok().flatten().unwrap_or_default()).into_owned();
         match am::parse_dialect(&f, &text) {
             Ok(d) if name != am::REFERENCE_DIALECT => {
                 store.dialects.insert(name, DialectEntry { dialect: d, text, builtin: false });
@@ -327,7 +324,8 @@ fn load_workspace(ws: &Workspace, store: &mut Store) {
             store.load_problems.push(format!("programs/{f}: no readable {meta_name}"));
             continue;
         };
-        let text = String::from_utf8_lossy(&ws.read(Kind::Programs, &f).ok().flatten().unwrap_or_default()).into_owned();
+        let text =
+            String::from_utf8_lossy(&ws.read(Kind::Programs, &f).ok().flatten().unwrap_or_default()).into_owned();
         let source = if meta.job.is_some() { Source::Result } else { Source::Upload };
         store.programs.insert(f.clone(), Arc::new(ProgramEntry::new(&f, source, meta, text)));
     }

@@ -9,8 +9,8 @@ use axum::http::{Request, StatusCode};
 use axum::Router;
 use http_body_util::BodyExt;
 use serde_json::{json, Value};
-use towpath_server::{router, AppState, Config};
 use tower::ServiceExt;
+use towpath_server::{router, AppState, Config};
 
 struct App {
     router: Router,
@@ -220,7 +220,11 @@ async fn read_events(app: &App, job: &str) -> Vec<(String, Value, f64)> {
                 }
             }
             if !name.is_empty() {
-                out.push((name.clone(), serde_json::from_str(&payload).unwrap_or(Value::Null), t0.elapsed().as_secs_f64()));
+                out.push((
+                    name.clone(),
+                    serde_json::from_str(&payload).unwrap_or(Value::Null),
+                    t0.elapsed().as_secs_f64(),
+                ));
             }
             if name == "end" {
                 return out;
@@ -318,7 +322,8 @@ async fn jobs_beyond_the_bound_queue_and_the_queue_is_bounded() {
     });
     let mut ids = Vec::new();
     for _ in 0..2 {
-        let (s, v) = post_json(&app, "/api/jobs/optimize", json!({"program": "demo-planar-0", "time_limit": 1.5})).await;
+        let (s, v) =
+            post_json(&app, "/api/jobs/optimize", json!({"program": "demo-planar-0", "time_limit": 1.5})).await;
         assert_eq!(s, StatusCode::ACCEPTED, "{v}");
         ids.push(v["id"].as_str().expect("id").to_string());
     }
@@ -329,7 +334,8 @@ async fn jobs_beyond_the_bound_queue_and_the_queue_is_bounded() {
     }
     let mut refused = s3 == StatusCode::TOO_MANY_REQUESTS;
     for _ in 0..3 {
-        let (s, _) = post_json(&app, "/api/jobs/optimize", json!({"program": "demo-planar-0", "time_limit": 1.5})).await;
+        let (s, _) =
+            post_json(&app, "/api/jobs/optimize", json!({"program": "demo-planar-0", "time_limit": 1.5})).await;
         refused |= s == StatusCode::TOO_MANY_REQUESTS;
         if s == StatusCode::ACCEPTED {
             break;
@@ -361,7 +367,8 @@ async fn machines_are_checked_saved_and_previewed() {
     let mut m = v["machine"].clone();
     m["name"] = json!("my-gantry");
     // Preview: a Cartesian gantry's tool point is its X, Y, Z.
-    let (s, p) = post_json(&app, "/api/machine-preview", json!({"machine": m, "values": [10.0, 20.0, 30.0, 90.0]})).await;
+    let (s, p) =
+        post_json(&app, "/api/machine-preview", json!({"machine": m, "values": [10.0, 20.0, 30.0, 90.0]})).await;
     assert_eq!(s, StatusCode::OK, "{p}");
     assert_eq!(p["tool_point"]["part"], json!([10.0, 20.0, 30.0]));
     // Saved as TOML in the workspace, and read back by a new server.

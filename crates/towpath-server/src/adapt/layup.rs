@@ -110,7 +110,8 @@ pub fn read_mesh(name: &str, bytes: &[u8]) -> Result<Mesh, ApiError> {
     let format = io::Format::from_path(std::path::Path::new(name))
         .ok_or_else(|| ApiError::in_file(name, None, "a mesh must be a .stl, .obj or .ply file"))?;
     let soup = io::read_bytes(bytes, format).map_err(|e| ApiError::in_file(name, None, e.to_string()))?;
-    let (mesh, _) = Mesh::build(&soup, &BuildOptions::default()).map_err(|e| ApiError::in_file(name, None, e.to_string()))?;
+    let (mesh, _) =
+        Mesh::build(&soup, &BuildOptions::default()).map_err(|e| ApiError::in_file(name, None, e.to_string()))?;
     Ok(mesh)
 }
 

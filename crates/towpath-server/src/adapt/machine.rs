@@ -30,8 +30,7 @@ pub fn parse_machine(file: &str, text: &str) -> Result<Machine, ApiError> {
 
 /// Checks a machine given as JSON (the machine editor's form) and returns it with its TOML.
 pub fn machine_from_json(value: serde_json::Value) -> Result<(Machine, String), ApiError> {
-    let m: Machine =
-        serde_json::from_value(value).map_err(|e| ApiError::bad(format!("machine: {e}")))?;
+    let m: Machine = serde_json::from_value(value).map_err(|e| ApiError::bad(format!("machine: {e}")))?;
     m.validate().map_err(|e| ApiError::bad(format!("machine: {e}")))?;
     let toml = m.to_toml_string();
     Ok((m, toml))

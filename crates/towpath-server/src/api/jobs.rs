@@ -167,7 +167,10 @@ pub async fn layup(
     let mesh_bytes = match &req.mesh {
         Some(name) => {
             names::check("mesh", name)?;
-            Some(s.ws.read(Kind::Meshes, name)?.ok_or_else(|| ApiError::bad(format!("no mesh {name:?}: upload it first")))?)
+            Some(
+                s.ws.read(Kind::Meshes, name)?
+                    .ok_or_else(|| ApiError::bad(format!("no mesh {name:?}: upload it first")))?,
+            )
         }
         None => None,
     };

@@ -118,9 +118,12 @@ pub async fn upload(
         order: None,
         job: None,
         tow_width: match q.get("tow_width") {
-            Some(t) => Some(t.parse::<f64>().ok().filter(|w| w.is_finite() && *w > 0.0).ok_or_else(|| {
-                ApiError::bad(format!("tow_width {t:?}: a width in mm > 0"))
-            })?),
+            Some(t) => Some(
+                t.parse::<f64>()
+                    .ok()
+                    .filter(|w| w.is_finite() && *w > 0.0)
+                    .ok_or_else(|| ApiError::bad(format!("tow_width {t:?}: a width in mm > 0")))?,
+            ),
             None => None,
         },
     };

@@ -117,8 +117,7 @@ pub async fn preview(Json(p): Json<Preview>) -> ApiResult<Json<Value>> {
 }
 
 pub async fn dialects(State(s): State<Arc<AppState>>) -> Json<Value> {
-    let list: Vec<Value> =
-        s.read().dialects.iter().map(|(n, d)| json!({"name": n, "builtin": d.builtin})).collect();
+    let list: Vec<Value> = s.read().dialects.iter().map(|(n, d)| json!({"name": n, "builtin": d.builtin})).collect();
     Json(json!({ "dialects": list }))
 }
 

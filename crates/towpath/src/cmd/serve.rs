@@ -10,11 +10,9 @@ use crate::{exit, outln};
 
 /// Arguments of `towpath serve`.
 #[derive(clap::Args, Debug)]
-#[command(
-    after_help = "The page is served from the binary itself; nothing is fetched from outside the machine.\n\
+#[command(after_help = "The page is served from the binary itself; nothing is fetched from outside the machine.\n\
 Everything uploaded, saved or produced is kept in the workspace folder, so a restart loses nothing.\n\n\
-Examples:\n  towpath serve --open\n  towpath serve --port 9000 --workspace ~/towpath-work"
-)]
+Examples:\n  towpath serve --open\n  towpath serve --port 9000 --workspace ~/towpath-work")]
 pub struct Args {
     /// Port to listen on (0: any free port, printed at start).
     #[arg(long, default_value_t = 8437)]
