@@ -2,7 +2,7 @@
 //!
 //! `towpath serve` runs [`serve`]: an HTTP server (axum on tokio), on the loopback address unless
 //! told otherwise, that serves the front end (embedded in the binary, see [`assets`]) and a
-//! JSON API under `/api/` ([`api`]):
+//! JSON API under `/api/` (the `api` module):
 //!
 //! - programs: the built-in demo parts and the large panel, uploads parsed by `towpath-nc` and
 //!   refused with the file, line and problem, and each program's geometry as typed arrays

@@ -154,7 +154,7 @@ pub fn generate(req: &LayupRequest, mesh: &Mesh, progress: &mut dyn FnMut(usize)
         (Box::new(Guides { curves, angle }), format!("{} guide curve(s)", req.guides.len()))
     } else {
         let axis = DVec3::from(req.axis);
-        if !(axis.length() > 0.0) || !axis.is_finite() {
+        if !axis.is_finite() || axis.length() <= 0.0 {
             return Err(ApiError::bad("axis: must not be zero"));
         }
         (Box::new(Rosette { axis: axis.normalize(), angle }), format!("axis {},{},{}", axis.x, axis.y, axis.z))

@@ -7,4 +7,5 @@ mod convert;
 mod layup;
 mod outputs_and_pipes;
 mod route;
+mod serve;
 mod solve;
