@@ -40,6 +40,8 @@ enum Command {
     Order(Box<cmd::order::Args>),
     /// Plan 2.5D pocket machining: toolpath cells per tool linked with the least airtime (Castelino et al. 2003).
     Machine(cmd::machine::Args),
+    /// Start the web application: machine set-up, programs in 3D, solves with live progress, layup.
+    Serve(cmd::serve::Args),
 }
 
 fn main() {
@@ -55,6 +57,7 @@ fn main() {
         Command::Bench(args) => cmd::bench::run(args),
         Command::Order(args) => cmd::order::run(*args),
         Command::Machine(args) => cmd::machine::run(args),
+        Command::Serve(args) => cmd::serve::run(args),
     };
     std::process::exit(exit::report(result));
 }

@@ -10,6 +10,7 @@ pub mod machine;
 pub mod optimize;
 pub mod order;
 pub mod route;
+pub mod serve;
 pub mod solve;
 pub mod solver_args;
 pub mod verify;

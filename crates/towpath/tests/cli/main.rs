@@ -9,4 +9,5 @@ mod machine;
 mod order;
 mod outputs_and_pipes;
 mod route;
+mod serve;
 mod solve;
