@@ -1,17 +1,17 @@
 //! Course generation on a mold surface: the surface (analytic or an uploaded mesh), the design
 //! direction, the ply, and the outputs. Every call into `towpath-layup` and `towpath-geom` is
-//! here. The library has no request type yet, so this module assembles the field, region and
-//! ply spec the way `towpath layup` does.
+//! here. A surface-view request becomes the library's [`towpath_layup::request::LayupRequest`], so
+//! the app gets the same checks, work limits and warnings as `towpath layup`.
 
 use serde::{Deserialize, Serialize};
-use towpath_geom::surface::{tessellate_analytic, Analytic, Tessellation};
-use towpath_geom::{io, BuildOptions, DVec3, Mesh};
-use towpath_layup::boundary::Region;
-use towpath_layup::field::{DirectionField, Guides, Polyline, Rosette};
+use towpath_geom::surface::{Analytic, Tessellation};
+use towpath_geom::{io, BuildOptions, DVec3, Mesh, Soup};
 use towpath_layup::input::read_curve;
 use towpath_layup::output::{self, Meta, Post};
-use towpath_layup::ply::{self, Method, PlySpec};
+use towpath_layup::ply::Method;
+use towpath_layup::request::{self as layup, DirectionSource, LayupError, Limits, SurfaceRequest, SurfaceSource};
 use towpath_layup::section::Coverage;
+use towpath_layup::units::Units;
 
 use crate::error::ApiError;
 use crate::geometry::Blob;
@@ -43,6 +43,8 @@ pub struct LayupRequest {
     pub start: Option<[f64; 3]>,
     /// Tessellate analytic surfaces into about this many triangles.
     pub triangles: Option<usize>,
+    /// Units of the surface and of every length in the request (`mm`, `in`, `m`, `ft`; default mm).
+    pub units: Option<String>,
 }
 
 impl Default for LayupRequest {
@@ -59,6 +61,7 @@ impl Default for LayupRequest {
             method: "field".into(),
             start: None,
             triangles: Some(20_000),
+            units: None,
         }
     }
 }
@@ -90,6 +93,7 @@ pub fn validate(req: &LayupRequest) -> Result<(), ApiError> {
         return Err(ApiError::bad(format!("coverage {}: 0, 50 or 100", req.coverage)));
     }
     method(&req.method)?;
+    units(req)?;
     if req.triangles.is_some_and(|t| !(100..=2_000_000).contains(&t)) {
         return Err(ApiError::bad("triangles: between 100 and 2,000,000"));
     }
@@ -105,28 +109,18 @@ fn method(m: &str) -> Result<Method, ApiError> {
     }
 }
 
-/// Reads an uploaded mesh's bytes into a mesh; errors name the file.
-pub fn read_mesh(name: &str, bytes: &[u8]) -> Result<Mesh, ApiError> {
+/// Reads an uploaded mesh's bytes into triangles; errors name the file.
+fn read_soup(name: &str, bytes: &[u8]) -> Result<Soup, ApiError> {
     let format = io::Format::from_path(std::path::Path::new(name))
         .ok_or_else(|| ApiError::in_file(name, None, "a mesh must be a .stl, .obj or .ply file"))?;
-    let soup = io::read_bytes(bytes, format).map_err(|e| ApiError::in_file(name, None, e.to_string()))?;
-    let (mesh, _) =
-        Mesh::build(&soup, &BuildOptions::default()).map_err(|e| ApiError::in_file(name, None, e.to_string()))?;
-    Ok(mesh)
+    io::read_bytes(bytes, format).map_err(|e| ApiError::in_file(name, None, e.to_string()))
 }
 
-/// Builds the surface of a request: an analytic description or the uploaded mesh's bytes.
-pub fn surface_mesh(req: &LayupRequest, mesh_bytes: Option<&[u8]>) -> Result<Mesh, ApiError> {
-    if let (Some(name), Some(bytes)) = (&req.mesh, mesh_bytes) {
-        return read_mesh(name, bytes);
-    }
-    let s = Analytic::parse(&req.surface).map_err(|e| ApiError::bad(format!("surface {:?}: {e}", req.surface)))?;
-    let tess = match req.triangles {
-        Some(n) => Tessellation::Triangles(n),
-        None => Tessellation::Chord { d_l2s: 0.05, l_seg: 20.0 },
-    };
-    let soup = tessellate_analytic(&s, &tess).map_err(|e| ApiError::bad(format!("surface {:?}: {e}", req.surface)))?;
-    let (mesh, _) = Mesh::build(&soup, &BuildOptions::default()).map_err(|e| ApiError::bad(e.to_string()))?;
+/// Reads an uploaded mesh's bytes into a mesh; errors name the file.
+pub fn read_mesh(name: &str, bytes: &[u8]) -> Result<Mesh, ApiError> {
+    let soup = read_soup(name, bytes)?;
+    let (mesh, _) =
+        Mesh::build(&soup, &BuildOptions::default()).map_err(|e| ApiError::in_file(name, None, e.to_string()))?;
     Ok(mesh)
 }
 
@@ -140,46 +134,85 @@ pub fn mesh_blob(mesh: &Mesh) -> Blob {
     b
 }
 
-/// Generates the ply. `progress` gets the number of courses traced so far.
-pub fn generate(req: &LayupRequest, mesh: &Mesh, progress: &mut dyn FnMut(usize)) -> Result<LayupOutcome, ApiError> {
+/// Generates the ply through the library's own request ([`towpath_layup::request::run`]): the
+/// same checks, limits and warnings as `towpath layup`. `mesh_bytes` are the uploaded mesh's, when
+/// the request names one. `progress` gets the number of courses traced so far.
+pub fn generate(
+    req: &LayupRequest,
+    mesh_bytes: Option<&[u8]>,
+    progress: &mut dyn FnMut(usize),
+) -> Result<LayupOutcome, ApiError> {
     validate(req)?;
-    let angle = req.angle.to_radians();
-    let (field, source): (Box<dyn DirectionField>, String) = if !req.guides.is_empty() {
+    let units = units(req)?;
+    let source = match (&req.mesh, mesh_bytes) {
+        (Some(name), Some(bytes)) => SurfaceSource::Soup(read_soup(name, bytes)?),
+        _ => SurfaceSource::Analytic(
+            Analytic::parse(&req.surface).map_err(|e| ApiError::bad(format!("surface {:?}: {e}", req.surface)))?,
+        ),
+    };
+    let direction = if !req.guides.is_empty() {
         let mut curves = Vec::new();
         for (i, g) in req.guides.iter().enumerate() {
             let file = format!("guide curve {}", i + 1);
-            let pts = read_curve(g).map_err(|e| ApiError::in_file(&file, None, e.to_string()))?;
-            curves.push(Polyline::new(pts).ok_or_else(|| ApiError::in_file(&file, None, "the curve has no length"))?);
+            curves.push(read_curve(g).map_err(|e| ApiError::in_file(&file, None, e.to_string()))?);
         }
-        (Box::new(Guides { curves, angle }), format!("{} guide curve(s)", req.guides.len()))
+        DirectionSource::Guides(curves)
     } else {
-        let axis = DVec3::from(req.axis);
-        if !axis.is_finite() || axis.length() <= 0.0 {
-            return Err(ApiError::bad("axis: must not be zero"));
-        }
-        (Box::new(Rosette { axis: axis.normalize(), angle }), format!("axis {},{},{}", axis.x, axis.y, axis.z))
+        DirectionSource::Axis(DVec3::from(req.axis))
     };
-    let mut spec = PlySpec::new(req.tow_width, req.tows);
-    spec.coverage = Coverage::from_percent(req.coverage).unwrap_or(Coverage::Half);
-    spec.method = method(&req.method)?;
-    spec.start = req.start.map(DVec3::from);
-    let region = Region::whole(mesh);
-    let ply = ply::plan(mesh, field.as_ref(), &region, &spec, progress).map_err(|e| ApiError::bad(e.to_string()))?;
+    let tessellation = match req.triangles {
+        Some(n) => Tessellation::Triangles(n),
+        None => Tessellation::Chord { d_l2s: 0.05 / units.mm(), l_seg: 20.0 / units.mm() },
+    };
+    let request = layup::LayupRequest {
+        surface: SurfaceRequest { source, tessellation, weld_tolerance: None },
+        units,
+        angle_deg: req.angle,
+        direction: direction.clone(),
+        method: method(&req.method)?,
+        tow_width: req.tow_width,
+        tows: req.tows,
+        coverage: Coverage::from_percent(req.coverage).unwrap_or(Coverage::Half),
+        boundary: None,
+        start: req.start.map(DVec3::from),
+        min_steering_radius: None,
+        limits: Limits::with_time_limit(Limits::DEFAULT_TIME_LIMIT),
+    };
+    let result = layup::run(request, progress).map_err(|e| refused(req, e))?;
     let meta = Meta {
         surface: req.mesh.clone().unwrap_or_else(|| req.surface.clone()),
         angle_deg: req.angle,
-        direction_source: source,
-        tow_width: req.tow_width,
+        direction_source: direction.describe(),
+        tow_width: result.tow_width_mm,
         tows: req.tows,
-        coverage_percent: spec.coverage.percent(),
-        method: spec.method,
+        coverage_percent: req.coverage,
+        method: method(&req.method)?,
         ply_number: 1,
+        input_units: units,
     };
-    let courses_json = output::to_json(&ply, &meta).to_string();
-    let gcode = output::to_gcode(&ply, &meta, &Post::default());
-    let mut summary = output::summary(&ply);
+    let courses_json = output::to_json(&result.ply, &meta).to_string();
+    let gcode = output::to_gcode(&result.ply, &meta, &Post::default());
+    let mut summary = output::summary(&result.ply);
     if let Some(o) = summary.as_object_mut() {
-        o.insert("mesh_triangles".into(), mesh.num_faces().into());
+        o.insert("mesh_triangles".into(), result.mesh.num_faces().into());
+        o.insert("units".into(), units.name().into());
+        o.insert("warnings".into(), result.warnings.iter().map(|w| w.to_string()).collect::<Vec<_>>().into());
     }
-    Ok(LayupOutcome { courses_json, gcode, mesh: mesh_blob(mesh), summary })
+    Ok(LayupOutcome { courses_json, gcode, mesh: mesh_blob(&result.mesh), summary })
+}
+
+/// The request's units (`mm` when not given).
+fn units(req: &LayupRequest) -> Result<Units, ApiError> {
+    match &req.units {
+        None => Ok(Units::Mm),
+        Some(u) => Units::parse(u).ok_or_else(|| ApiError::bad(format!("units {u:?}: mm, in, m or ft"))),
+    }
+}
+
+/// A library refusal in the request's terms; mesh problems name the uploaded file.
+fn refused(req: &LayupRequest, e: LayupError) -> ApiError {
+    match (&req.mesh, &e) {
+        (Some(name), LayupError::Mesh(_)) => ApiError::in_file(name, None, e.to_string()),
+        _ => ApiError::bad(e.to_string()),
+    }
 }

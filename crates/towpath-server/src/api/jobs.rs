@@ -176,11 +176,9 @@ pub async fn layup(
     };
     let target = req.mesh.clone().unwrap_or_else(|| req.surface.clone());
     let work = Box::new(move |ctx: &crate::jobs::JobCtx| {
-        ctx.phase("building the surface");
-        let mesh = layup::surface_mesh(&req, mesh_bytes.as_deref())?;
-        ctx.phase("tracing courses");
+        ctx.phase("building the surface and tracing courses");
         let c = ctx.clone();
-        let out = layup::generate(&req, &mesh, &mut |n| c.count(n as u64))?;
+        let out = layup::generate(&req, mesh_bytes.as_deref(), &mut |n| c.count(n as u64))?;
         Ok(JobOutput {
             result: json!({ "summary": out.summary }),
             files: vec![
