@@ -14,7 +14,8 @@
 //! arcs outside the XY plane (G18, G19), coordinate offsets (G92), words without a number,
 //! arcs whose centre is not equidistant from their ends.
 //!
-//! **Writing.** Header; for each piece in the new order one rapid `G0 X.. Y..` to its entry,
+//! **Writing.** Header; for each piece in the new order one rapid `G0 X.. Y..` to its entry
+//! (none when the piece starts exactly where the one before ended),
 //! its plunge lines, its lead-in (feed moves), its moves (the original lines if it is done as
 //! written, else regenerated as G1/G2/G3 with the feed that was in effect), its retract lines;
 //! then the footer. Every other line is kept as written.
@@ -419,10 +420,16 @@ fn moves(path: &Path, feed: Option<&str>, out: &mut Vec<String>) {
 /// Writes an ordering as G-code.
 pub fn write(source: &GcodeSource, _drawing: &Drawing, order: &[Placement]) -> String {
     let mut out: Vec<String> = source.header.clone();
+    // Where the previous piece ended: a piece that starts exactly there (strokes joined by
+    // `--merge`) needs no rapid, a move to where the tool already is.
+    let mut at: Option<[f64; 2]> = None;
     for pl in order {
         let Some(b) = source.blocks.get(pl.piece) else { continue };
         let e = pl.entry();
-        out.push(format!("G0 X{} Y{}", fmt(e[0]), fmt(e[1])));
+        if pl.lead_in.is_some() || at != Some(e) {
+            out.push(format!("G0 X{} Y{}", fmt(e[0]), fmt(e[1])));
+        }
+        at = Some(pl.path.end());
         if let Some(m) = &b.prefix_mode {
             out.push(m.clone());
         }
