@@ -124,6 +124,9 @@ pub struct Optimized {
     /// The solver's order measured worse than the input on the program itself, so the input
     /// was returned unchanged.
     pub fell_back: bool,
+    /// The course width used and where it came from (with a warning if the width given
+    /// disagrees with the dialect's).
+    pub width: crate::width::WidthUsed,
 }
 
 /// Optimizes a program: returns the rewritten text, verified against the input, never costing
@@ -137,6 +140,7 @@ pub fn optimize(
 ) -> Result<Optimized, NcError> {
     let t0 = Instant::now();
     let program = crate::parse::parse(text, machine, dialect)?;
+    let width = crate::width::WidthUsed::choose(opts.afp.width, dialect, &program);
     let t_parse = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let afp = build_problem(&program, machine, dialect, &opts.afp)?;
@@ -209,6 +213,7 @@ pub fn optimize(
             total: t0.elapsed().as_secs_f64(),
         },
         fell_back,
+        width,
     })
 }
 

@@ -38,6 +38,7 @@ impl Hasher for CellHasher {
 /// A hash map keyed by grid cells.
 pub(crate) type CellMap<V> = HashMap<(i64, i64), V, BuildHasherDefault<CellHasher>>;
 
+use crate::error::NcError;
 use crate::footprint::{Footprints, Frame, Quad};
 
 /// A uniform grid over the footprint frame (periodic in its second coordinate if the frame is).
@@ -58,7 +59,52 @@ pub(crate) struct CellStore<V> {
 }
 
 /// Largest dense cell store, in cells.
-const MAX_DENSE_CELLS: i64 = 8_000_000;
+const MAX_DENSE_CELLS: i64 = 2_000_000;
+
+/// Most (rectangle, cell) incidences a grid may hold: the cells grow until the footprints' pieces
+/// touch no more than this many (so its memory stays bounded whatever the widths and lengths).
+pub(crate) const MAX_CELL_HITS: u64 = 8_000_000;
+
+/// Most grid entries a precedence search may visit before giving up (seconds of work): about 30
+/// times what the benchmark's 100-ply, 10,000-course panel needs for course precedence
+/// (3.4·10⁷; the demo parts need at most 3·10⁴), so only footprints piled up by the thousand
+/// over one place reach it.
+pub const MAX_VISITS: u64 = 1_000_000_000;
+
+/// Counts the grid entries a search visits, across threads, and says when to stop.
+pub(crate) struct Budget {
+    used: std::sync::atomic::AtomicU64,
+    limit: u64,
+}
+
+impl Budget {
+    pub(crate) fn new(limit: u64) -> Self {
+        Budget { used: std::sync::atomic::AtomicU64::new(0), limit }
+    }
+
+    /// Adds `n` visits; false once the limit is passed.
+    #[inline]
+    pub(crate) fn spend(&self, n: u64) -> bool {
+        self.used.fetch_add(n, std::sync::atomic::Ordering::Relaxed).saturating_add(n) <= self.limit
+    }
+
+    pub(crate) fn exceeded(&self) -> bool {
+        self.used.load(std::sync::atomic::Ordering::Relaxed) > self.limit
+    }
+
+    /// The error for a search that ran out of budget.
+    pub(crate) fn error(&self, what: &str) -> NcError {
+        NcError::WorkLimit {
+            what: what.into(),
+            limit: self.limit,
+            unit: "footprint comparisons".into(),
+            advice: "the courses' footprints are piled up far more densely than on any real part (thousands of \
+                     courses over the same place); check the program and the course width, or lay ply by ply, \
+                     which needs no footprints"
+                .into(),
+        }
+    }
+}
 
 impl<V: Default> CellStore<V> {
     pub fn new(grid: &Grid) -> Self {
@@ -105,20 +151,42 @@ pub(crate) struct CellHit {
 }
 
 impl Grid {
-    /// A grid with cells `factor` times the median rectangle width.
+    /// A grid with cells `factor` times the median rectangle width, or larger when the
+    /// footprints would touch more than [`MAX_CELL_HITS`] cells in all.
     pub fn new(fps: &Footprints, factor: f64) -> Self {
         let mut widths: Vec<f64> = fps.courses.iter().flat_map(|f| f.quads.iter().map(|q| 2.0 * q.hw)).collect();
-        let size = if widths.is_empty() {
+        let mut size = if widths.is_empty() {
             1.0
         } else {
             let mid = widths.len() / 2;
             let (_, m, _) = widths.select_nth_unstable_by(mid, f64::total_cmp);
             (*m * factor).max(1e-3)
         };
-        let rows = fps.frame.period().map(|p| {
-            let n = (p / size).ceil().max(1.0);
-            (p / n, n as i64)
-        });
+        let rows_for = |size: f64| {
+            fps.frame.period().map(|p| {
+                let n = (p / size).ceil().max(1.0);
+                (p / n, n as i64)
+            })
+        };
+        // Cells touched by every rectangle's bounds (at least those `cells` reports).
+        let hits = |size: f64| -> u64 {
+            let h = rows_for(size).map_or(size, |r| r.0);
+            let mut total = 0u64;
+            for q in fps.courses.iter().flat_map(|f| f.quads.iter()) {
+                let (a, b) = q.bounds();
+                let nx = ((b[0] / size).floor() - (a[0] / size).floor() + 1.0).max(1.0);
+                let ny = ((b[1] / h).floor() - (a[1] / h).floor() + 1.0).max(1.0);
+                total = total.saturating_add((nx * ny).min(u64::MAX as f64 / 4.0) as u64);
+                if total > MAX_CELL_HITS {
+                    break;
+                }
+            }
+            total
+        };
+        while hits(size) > MAX_CELL_HITS && size.is_finite() {
+            size *= 2.0;
+        }
+        let rows = rows_for(size);
         let h = rows.map_or(size, |r| r.0);
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for q in fps.courses.iter().flat_map(|f| f.quads.iter()) {
@@ -149,9 +217,7 @@ impl Grid {
         let h = self.rows.map_or(self.size, |r| r.0);
         let (i0, i1) = ((lo[0] / self.size).floor() as i64, (hi[0] / self.size).floor() as i64);
         let (j0, j1) = ((lo[1] / h).floor() as i64, (hi[1] / h).floor() as i64);
-        if (i1 - i0 + 1).saturating_mul(j1 - j0 + 1) > 4_000_000 {
-            return;
-        }
+        // `Grid::new` sized the cells so that every rectangle touches few of them.
         for i in i0..=i1 {
             for j in j0..=j1 {
                 let cell = Quad {
@@ -235,14 +301,26 @@ struct Scratch {
     hits: Vec<CellHit>,
 }
 
-/// Above this many courses the implied-edge bookkeeping (n² bits) is skipped; the result is
-/// still correct, with more edges.
-const MAX_BITSET_COURSES: usize = 60_000;
+/// Above this many courses the implied-edge bookkeeping (n² bits, 112 MB at the limit) is
+/// skipped; the result is still correct, with more edges.
+const MAX_BITSET_COURSES: usize = 30_000;
 
 /// Course-level precedence edges `(before, after)`: `after` overlaps `before`, which belongs to
 /// an earlier ply. `plies[p]` lists the courses of ply p. The transitive closure of the edges
-/// equals the full relation; most implied edges are left out.
-pub fn course_precedence(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<(usize, usize)> {
+/// equals the full relation; most implied edges are left out. Refused
+/// ([`NcError::WorkLimit`]) when the footprints are piled up so densely that the search would
+/// visit more than [`MAX_VISITS`] grid entries.
+pub fn course_precedence(fps: &Footprints, plies: &[Vec<usize>]) -> Result<Vec<(usize, usize)>, NcError> {
+    course_precedence_within(fps, plies, MAX_VISITS)
+}
+
+/// [`course_precedence`] under a visit budget.
+pub(crate) fn course_precedence_within(
+    fps: &Footprints,
+    plies: &[Vec<usize>],
+    limit: u64,
+) -> Result<Vec<(usize, usize)>, NcError> {
+    let budget = Budget::new(limit);
     let n = fps.courses.len();
     let mut ply_of = vec![0u32; n];
     for (p, cs) in plies.iter().enumerate() {
@@ -266,10 +344,17 @@ pub fn course_precedence(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<(usize, 
                     let fc = &fps.courses[c];
                     let me = c as u32;
                     sc.list.clear();
+                    let mut spent = 0u64;
                     for (qi, q) in fc.quads.iter().enumerate() {
                         grid.cells(q, &fc.moves[fc.move_of[qi] as usize], &mut sc.hits);
                         for h in &sc.hits {
                             let Some(stack) = cells.get(h.key) else { continue };
+                            spent += stack.len() as u64 + 1;
+                            if spent >= 1 << 16 {
+                                if !budget.spend(std::mem::take(&mut spent)) {
+                                    return (c, Vec::new(), Bits::default());
+                                }
+                            }
                             let mut stop: Option<u32> = None;
                             for e in stack.iter().rev() {
                                 let pb = e.ply;
@@ -295,6 +380,7 @@ pub fn course_precedence(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<(usize, 
                             }
                         }
                     }
+                    budget.spend(spent);
                     let mut list: Vec<u32> =
                         sc.list.iter().copied().filter(|&b| sc.state[b as usize] == OVERLAP).collect();
                     list.sort_unstable_by_key(|&b| (std::cmp::Reverse(ply_of[b as usize]), b));
@@ -315,6 +401,9 @@ pub fn course_precedence(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<(usize, 
                 },
             )
             .collect();
+        if budget.exceeded() {
+            return Err(budget.error("course precedence"));
+        }
         for (c, preds, bits) in results {
             for b in preds {
                 edges.push((b, c));
@@ -344,12 +433,23 @@ pub fn course_precedence(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<(usize, 
             cells.get_mut(key).retain(|e| e.ply as usize >= p);
         }
     }
-    edges
+    Ok(edges)
 }
 
 /// Seed 000's precedence network: consecutive plies joined while the next ply intersects none
-/// of the set's courses. Returns the sets as lists of plies.
-pub fn precedence_sets(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<Vec<usize>> {
+/// of the set's courses. Returns the sets as lists of plies. Refused like
+/// [`course_precedence`] beyond [`MAX_VISITS`] grid entries.
+pub fn precedence_sets(fps: &Footprints, plies: &[Vec<usize>]) -> Result<Vec<Vec<usize>>, NcError> {
+    precedence_sets_within(fps, plies, MAX_VISITS)
+}
+
+/// [`precedence_sets`] under a visit budget.
+pub(crate) fn precedence_sets_within(
+    fps: &Footprints,
+    plies: &[Vec<usize>],
+    limit: u64,
+) -> Result<Vec<Vec<usize>>, NcError> {
+    let budget = Budget::new(limit);
     let grid = Grid::new(fps, 2.0);
     let frame = fps.frame;
     let mut sets: Vec<Vec<usize>> = Vec::new();
@@ -363,6 +463,10 @@ pub fn precedence_sets(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<Vec<usize>
                     grid.cells(q, q, &mut hits);
                     hits.iter().any(|h| {
                         cells.get(h.key).is_some_and(|stack| {
+                            // Out of budget: stop scanning (the error follows).
+                            if !budget.spend(stack.len() as u64 + 1) {
+                                return true;
+                            }
                             stack.iter().any(|e| {
                                 quads_overlap(&frame, q, &fps.courses[e.course as usize].quads[e.quad as usize])
                             })
@@ -370,6 +474,9 @@ pub fn precedence_sets(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<Vec<usize>
                     })
                 })
             });
+        if budget.exceeded() {
+            return Err(budget.error("seed 000's precedence sets"));
+        }
         if sets.is_empty() || intersects {
             sets.push(Vec::new());
             for key in touched.drain(..) {
@@ -389,7 +496,7 @@ pub fn precedence_sets(fps: &Footprints, plies: &[Vec<usize>]) -> Vec<Vec<usize>
             }
         }
     }
-    sets
+    Ok(sets)
 }
 
 #[cfg(test)]
@@ -441,7 +548,7 @@ mod tests {
             let n = courses.len();
             let plies: Vec<Vec<usize>> = (0..n).collect::<Vec<_>>().chunks(per_ply).map(|c| c.to_vec()).collect();
             let fps = Footprints { frame: Frame::Plan, courses };
-            let edges = course_precedence(&fps, &plies);
+            let edges = course_precedence(&fps, &plies).unwrap();
             let ply_of = |c: usize| c / per_ply;
             for &(a, b) in &edges {
                 prop_assert!(ply_of(a) < ply_of(b));
@@ -474,7 +581,7 @@ mod tests {
             plies.push(ply);
         }
         let fps = Footprints { frame: Frame::Plan, courses };
-        let edges = course_precedence(&fps, &plies);
+        let edges = course_precedence(&fps, &plies).unwrap();
         assert_eq!(edges.len(), 90, "{edges:?}");
         assert!(edges.iter().all(|&(a, b)| b == a + 10));
     }
@@ -486,7 +593,7 @@ mod tests {
         let pad2 = band([500.0, 0.0], [600.0, 0.0], 50.0);
         let pad3 = band([150.0, 0.0], [550.0, 0.0], 50.0);
         let fps = Footprints { frame: Frame::Plan, courses: vec![base, pad1, pad2, pad3] };
-        let sets = precedence_sets(&fps, &[vec![0], vec![1], vec![2], vec![3]]);
+        let sets = precedence_sets(&fps, &[vec![0], vec![1], vec![2], vec![3]]).unwrap();
         assert_eq!(sets, vec![vec![0], vec![1, 2], vec![3]]);
     }
 }

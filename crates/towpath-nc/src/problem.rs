@@ -17,7 +17,7 @@ use crate::footprint::{footprints, Footprints, Width};
 use crate::interp::Interp;
 use crate::precedence::{course_precedence, precedence_sets};
 use crate::program::Program;
-use crate::reverse::{reversal_of, Reversed};
+use crate::reverse::{reversal_of, Irreversible, Reversed};
 
 /// Which precedence to impose.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
@@ -103,7 +103,7 @@ pub struct AfpProblem {
     /// How every course that has a reverse mode reverses (its lines are written when needed).
     pub reversed: Vec<Option<Reversed>>,
     /// Courses that could not be reversed, and why.
-    pub not_reversible: Vec<(usize, String)>,
+    pub not_reversible: Vec<(usize, Irreversible)>,
     /// The footprints, if computed.
     pub footprints: Option<Footprints>,
     /// Number of precedence edges given to the solver.
@@ -135,7 +135,7 @@ pub fn build_problem(
         _ => None,
     };
     let set_plies = match &fps {
-        Some(f) => precedence_sets(f, &plies),
+        Some(f) => precedence_sets(f, &plies)?,
         None => (0..plies.len()).map(|p| vec![p]).collect(),
     };
     let sets: Vec<Vec<usize>> =
@@ -146,7 +146,7 @@ pub fn build_problem(
     let mut not_reversible = Vec::new();
     if opts.bidirectional {
         use rayon::prelude::*;
-        let all: Vec<Result<Reversed, String>> =
+        let all: Vec<Result<Reversed, Irreversible>> =
             (0..k).into_par_iter().map(|c| reversal_of(program, c, machine, dialect)).collect();
         for (c, r) in all.into_iter().enumerate() {
             match r {
@@ -191,7 +191,7 @@ pub fn build_problem(
     match opts.precedence {
         PrecedenceRule::Courses => {
             if let Some(f) = &fps {
-                for (x, y) in course_precedence(f, &plies) {
+                for (x, y) in course_precedence(f, &plies)? {
                     b.precede(TaskId(x as u32), TaskId(y as u32));
                     edges += 1;
                 }

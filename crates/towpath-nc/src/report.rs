@@ -9,6 +9,7 @@ use towpath_machine::{CostKind, Machine};
 use crate::footprint::{frame_for, Frame};
 use crate::optimize::{Optimized, SolverSummary, Timings};
 use crate::problem::PrecedenceRule;
+use crate::reverse::Irreversible;
 use crate::program::{ply_name, Program};
 use crate::verify::{Motion, Verification};
 
@@ -119,6 +120,14 @@ pub struct Report {
     pub verified: bool,
     /// The input was returned unchanged because nothing cheaper was found.
     pub fell_back: bool,
+    /// The course width used and where it came from.
+    pub width: crate::width::WidthUsed,
+    /// Where the width came from, in words for the user (`the dialect`; a caller that knows how
+    /// the width was given may say so, e.g. `the command line`).
+    pub width_from: String,
+    /// Things the user should know: a width that disagrees with the dialect's, courses kept
+    /// forward because of lines the dialect does not describe.
+    pub warnings: Vec<String>,
 }
 
 fn pct(before: f64, after: f64) -> f64 {
@@ -237,6 +246,35 @@ impl Report {
             timings: o.timings.clone(),
             verified: true,
             fell_back: o.fell_back,
+            width: o.width.clone(),
+            width_from: match o.width.source {
+                crate::width::WidthSource::Given => "given with the run".into(),
+                crate::width::WidthSource::Dialect => "the dialect".into(),
+                crate::width::WidthSource::Default => "none given".into(),
+            },
+            warnings: o
+                .width
+                .warning
+                .iter()
+                .cloned()
+                .chain(o.afp.not_reversible.iter().filter(|(_, why)| !matches!(why, Irreversible::Other(_))).map(
+                    |(c, why)| format!("{} is laid forward only: {why}", p.course_name(*c)),
+                ))
+                .collect(),
+        }
+    }
+
+    /// The width line of the summary: which width, and where it came from.
+    pub fn width_line(&self) -> String {
+        match self.width.width {
+            Some(w) => format!(
+                "{}{} (from {})",
+                crate::width::WidthUsed { width: Some(w), ..self.width.clone() }.describe(),
+                if matches!(w, crate::footprint::Width::Tow(_)) { " × tows on" } else { "" },
+                self.width_from
+            ),
+            None if self.plies <= 1 => "none (one ply: no footprints needed)".into(),
+            None => "none (ply by ply: no footprints needed)".into(),
         }
     }
 
@@ -280,13 +318,19 @@ impl Report {
         }
         let _ = writeln!(
             s,
-            "  {} courses reversed; verified; {:.2} s (solver {}: {:.2} s){}",
+            "  {} courses reversed{}; verified; {:.2} s (solver {}: {:.2} s){}",
             self.reversed,
+            if self.bidirectional && !self.not_reversible.is_empty() {
+                format!(" ({} kept forward: see the report)", self.not_reversible.len())
+            } else {
+                String::new()
+            },
             self.timings.total,
             self.solver.solver,
             self.timings.solve,
             if self.fell_back { "; no cheaper order found: the input is returned unchanged" } else { "" }
         );
+        let _ = writeln!(s, "  width: {}", self.width_line());
         s
     }
 
@@ -316,6 +360,10 @@ impl Report {
             self.reversed,
             if self.fell_back { " No cheaper order was found: the input is returned unchanged." } else { "" }
         );
+        let _ = writeln!(h, "<p>Course width: {}.</p>", esc(&self.width_line()));
+        for w in &self.warnings {
+            let _ = writeln!(h, "<p><b>Warning:</b> {}</p>", esc(w));
+        }
         h.push_str("<h2>Totals</h2><table><tr><th>cost model</th><th>off-part before</th><th>off-part after</th><th>saved</th><th>total before</th><th>total after</th><th>saved</th><th>unit</th></tr>\n");
         for t in &self.totals {
             let _ = writeln!(
@@ -404,7 +452,7 @@ fn plan_views(o: &Optimized, optimized: &Program, machine: &Machine) -> Option<S
     let kin = machine.kinematics()?;
     let frame = match &o.afp.footprints {
         Some(f) => f.frame,
-        None => frame_for(&o.program, machine, &kin),
+        None => frame_for(&o.program, machine, &kin, None).unwrap_or(Frame::Plan),
     };
     let before = polylines(&o.program, machine, &frame);
     let after = polylines(optimized, machine, &frame);

@@ -385,6 +385,7 @@ fn arcs_on_part_are_kept_as_written_and_refuse_only_reversal() {
         if bi {
             let (c, why) = &r.afp.not_reversible[0];
             assert_eq!((*c, r.afp.not_reversible.len()), (1, 1));
+            let why = why.to_string();
             assert!(why.contains(&format!("line {line}")) && why.contains("arc"), "{why}");
             assert!(r.verification.reversed > 0, "the other courses still reverse");
         }
@@ -395,7 +396,7 @@ fn arcs_on_part_are_kept_as_written_and_refuse_only_reversal() {
     let e = verify(&text, &flipped, &m, &d, &vopts()).unwrap_err();
     assert!(matches!(e, VerifyError::Unmatched { .. }), "{e}");
     // Reversing that course on purpose is refused, naming the line.
-    let e = towpath_nc::reverse_course(&p, 1, &m, &d).unwrap_err();
+    let e = towpath_nc::reverse_course(&p, 1, &m, &d).unwrap_err().to_string();
     assert!(e.contains(&format!("line {line}")), "{e}");
 }
 
@@ -640,26 +641,40 @@ fn a_course_that_lays_nothing_reverses_and_verifies() {
     }
 }
 
-/// A rapid move on-part moves at the machine's speed whatever the modal feed, so reversed
-/// after a feed change it is still the same move; turning it into a feed move is not. Found by
-/// the fuzz target.
+/// A rapid move may not run while the roller is in contact (issue 17): such a program is refused
+/// by the optimizer and the verifier alike, naming the line, whether `G0` is written on the
+/// line or modal; outside contact rapids are as they were.
 #[test]
-fn rapid_moves_on_part_have_no_feed_to_compare() {
+fn rapid_moves_in_contact_are_refused() {
     let d = Dialect::default();
     let m = gantry();
     let odd = "(COURSE 2)\nG0 X0 Y100 Z20 C0\nG1 Z0 F1000\nM20\nM60 P1\nG0 X50\nF91\nG1 X100\nM61 P1\nM21\nG1 Z20\n";
     let text = format!("G90\n(PLY 1)\n{}{odd}M30\n", course(1, 0.0, 0.0, 400.0));
-    let p = parse(&text, &m, &d).unwrap();
-    let rev: Vec<_> = (0..2).map(|c| towpath_nc::reverse_course(&p, c, &m, &d).ok()).collect();
-    let order = vec![Placement { course: 1, reversed: true }, Placement { course: 0, reversed: false }];
-    let out = rewrite(&p, &order, &m, &d, &rev).unwrap();
-    verify(&text, &out, &m, &d, &vopts()).unwrap();
-    let order = vec![Placement { course: 1, reversed: false }, Placement { course: 0, reversed: false }];
-    let out = rewrite(&p, &order, &m, &d, &rev).unwrap();
-    verify(&text, &out, &m, &d, &vopts()).unwrap();
-    let fed = out.replacen("G0 X50\n", "G1 X50\n", 1);
-    assert_ne!(fed, out);
-    assert!(matches!(verify(&text, &fed, &m, &d, &vopts()).unwrap_err(), VerifyError::Unmatched { .. }));
+    let line = text.lines().position(|l| l == "G0 X50").unwrap() + 1;
+    let e = parse(&text, &m, &d).unwrap_err().to_string();
+    assert!(e.starts_with(&format!("line {line}: a rapid move (G0) while the roller is in contact")), "{e}");
+    assert!(optimize(&text, &m, &d, &opts(true)).is_err());
+    let good = text.replace("G0 X50", "G1 X50");
+    parse(&good, &m, &d).unwrap();
+    // The verifier reads the optimized program the same way: a rapid slipped in is refused.
+    let e = verify(&good, &text, &m, &d, &vopts()).unwrap_err();
+    assert!(matches!(&e, VerifyError::Optimized(NcError::Line { line: l, .. }) if *l == line), "{e}");
+    // Modal: G0 set before contact, then a bare axis move in contact.
+    let modal = good.replace("M20\nM60 P1\nG1 X50", "G0\nM20\nM60 P1\nX50");
+    assert_ne!(modal, good);
+    let e = parse(&modal, &m, &d).unwrap_err().to_string();
+    assert!(e.contains("a rapid move (G0) while the roller is in contact"), "{e}");
+    // Without contact codes: while tows are on.
+    let d2 = Dialect { contact_on: String::new(), contact_off: String::new(), ..Dialect::default() };
+    let no_contact = text.replace("M20\n", "").replace("M21\n", "");
+    let e = parse(&no_contact, &m, &d2).unwrap_err().to_string();
+    assert!(e.contains("a rapid move (G0) while tows are on (mask 1)"), "{e}");
+    // Tow and contact codes written on the rapid's line take effect after it: "G0 X0 M20"
+    // moves before contact, "G0 X0 M21" in contact.
+    let after = good.replacen("G1 Z0 F1000\nM20\n", "G1 Z0 F1000\nG0 Z0 M20\n", 1);
+    parse(&after, &m, &d).unwrap();
+    let lift = good.replacen("M61 P1\nM21\n", "M61 P1\nG0 X100 M21\n", 1);
+    assert!(parse(&lift, &m, &d).unwrap_err().to_string().contains("rapid move (G0) while the roller is in contact"));
 }
 
 /// Two courses that lay exactly the same, one with a retract move and one without: the
@@ -767,7 +782,7 @@ fn contact_codes_outside_the_on_part_block_keep_a_course_forward() {
     let text = program().replacen("G1 Z0 F1000\nM20\n", "G1 Z0 F1000\nM21 (make sure)\nM20\n", 1);
     assert_ne!(text, program());
     let p = parse(&text, &m, &d).unwrap();
-    let e = towpath_nc::reverse_course(&p, 0, &m, &d).unwrap_err();
+    let e = towpath_nc::reverse_course(&p, 0, &m, &d).unwrap_err().to_string();
     assert!(e.contains("outside the on-part block"), "{e}");
     let o = optimize(&text, &m, &d, &opts(true)).unwrap();
     assert_eq!(o.afp.not_reversible.iter().map(|x| x.0).collect::<Vec<_>>(), vec![0]);

@@ -295,7 +295,10 @@ fn bad_input_is_refused_with_the_line() {
     let opened = good.lines().take(last_lift).enumerate().filter(|(_, l)| *l == "M20").map(|(i, _)| i).last().unwrap();
     let cut: Vec<&str> = good.lines().enumerate().filter(|(i, _)| *i != last_lift).map(|(_, l)| l).collect();
     let (l, m) = err_line(&(cut.join("\n") + "\n"));
-    assert_eq!(l, good.lines().count() - 1, "{m}");
+    // The footer's rapid G0 Z100, now in contact: refused, naming the course.
+    let rapid = cut.iter().rposition(|l| *l == "G0 Z100").unwrap() + 1;
+    assert_eq!(l, rapid, "{m}");
+    assert!(m.contains("a rapid move (G0) while the roller is in contact"), "{m}");
     assert!(
         m.contains(&format!("inside the course opened at line {}", opened + 1)) && m.contains("M21 is missing"),
         "{m}"

@@ -252,7 +252,7 @@ proptest! {
         for c in 0..p.courses.len() {
             match reverse_course(&p, c, &m, &d) {
                 Ok(r) => prop_assert!(r.shift.abs() == 180.0 && !arcs[c]),
-                Err(why) => prop_assert!(arcs[c] && why.contains("arc"), "{}", why),
+                Err(why) => prop_assert!(arcs[c] && why.to_string().contains("arc"), "{}", why),
             }
         }
     }
