@@ -495,10 +495,18 @@ heading = true
             assert!(e.contains(says), "{to}: {e}");
         };
         refused("weight = 1.0", "weight = 1e308", "line 6: axis[0].weight: 1e308 is above 1e6");
-        refused("max_velocity = 1000.0", "max_velocity = 1e-300", "line 7: axis[0].max_velocity: 1e-300 is outside 1e-3 to 1e7 mm/s or deg/s");
+        refused(
+            "max_velocity = 1000.0",
+            "max_velocity = 1e-300",
+            "line 7: axis[0].max_velocity: 1e-300 is outside 1e-3 to 1e7 mm/s or deg/s",
+        );
         refused("max_velocity = 1000.0", "max_velocity = 1e300", "line 7: axis[0].max_velocity");
         refused("max_acceleration = 2000.0", "max_acceleration = 1e10", "line 8: axis[0].max_acceleration");
-        refused("heading = true", "heading = true\nhome = 1e8", "line 13: axis[1].home: 1e8 is not a number within ±1e7");
+        refused(
+            "heading = true",
+            "heading = true\nhome = 1e8",
+            "line 13: axis[1].home: 1e8 is not a number within ±1e7",
+        );
         refused("heading = true", "heading = true\nkind2 = 1", "line 13");
         let with = |extra: &str| Machine::from_toml_str(&format!("{GANTRY}{extra}"));
         let e = with("[[dh]]\na = 2e7\n").unwrap_err().to_string();
@@ -521,7 +529,10 @@ heading = true
         // A machine built in code has no line to name.
         let mut x = Axis::new("X", AxisKind::Linear);
         x.weight = 1e7;
-        assert_eq!(Machine::new("m", vec![x]).unwrap_err().to_string(), "axis[0].weight: 1e7 is above 1e6: weights are relative, keep them within 0 to 1e6");
+        assert_eq!(
+            Machine::new("m", vec![x]).unwrap_err().to_string(),
+            "axis[0].weight: 1e7 is above 1e6: weights are relative, keep them within 0 to 1e6"
+        );
     }
 
     /// Every key a machine file can hold, collected from a machine that sets them all.

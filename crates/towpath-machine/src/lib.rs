@@ -30,8 +30,8 @@ mod locate;
 mod motion;
 
 pub use config::{
-    Axis, AxisKind, DhJoint, Machine, MachineError, ACCELERATION_RANGE, MAX_AXES, MAX_AXIS_VALUE, MAX_DH_ANGLE, MAX_WEIGHT,
-    VELOCITY_RANGE,
+    Axis, AxisKind, DhJoint, Machine, MachineError, ACCELERATION_RANGE, MAX_AXES, MAX_AXIS_VALUE, MAX_DH_ANGLE,
+    MAX_WEIGHT, VELOCITY_RANGE,
 };
 pub use cost::{CostError, CostKind, MachineCost, StateTable};
 pub use kinematics::Kinematics;

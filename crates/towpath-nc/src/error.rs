@@ -49,8 +49,8 @@ pub enum NcError {
     #[error(
         "line {line}: the tool point is {radius:.4} mm from the mandrel axis (through {origin:?} along {direction:?}) \
          while laying a course {width:.3} mm wide: closer than the width / 2π ({min:.4} mm), so the course would wrap the \
-         whole mandrel and its footprint cannot be unrolled; check the mandrel's origin and direction \
-         (axis[{axis}].origin and axis[{axis}].direction of the machine) against the program's axis values",
+         whole mandrel and its footprint cannot be unrolled; check the origin and direction of the machine's mandrel \
+         axis {label} against the program's axis values",
         min = width / std::f64::consts::TAU
     )]
     MandrelAxis {
@@ -62,6 +62,8 @@ pub enum NcError {
         width: f64,
         /// Index of the mandrel among the machine's axes.
         axis: usize,
+        /// The mandrel axis's label.
+        label: String,
         /// The axis's origin, as used.
         origin: [f64; 3],
         /// The axis's unit direction, as used.

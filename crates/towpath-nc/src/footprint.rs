@@ -230,7 +230,12 @@ fn laid_moves(program: &Program, width: Option<Width>) -> Vec<(usize, usize, f64
 /// mandrel at the median radius of the laid points. Refused when a laid point lies closer to
 /// the mandrel axis than its course width / 2π (its course would wrap the whole mandrel there;
 /// without a width: closer than 1 µm), naming the line: the footprints cannot be unrolled.
-pub fn frame_for(program: &Program, machine: &Machine, kin: &Kinematics, width: Option<Width>) -> Result<Frame, NcError> {
+pub fn frame_for(
+    program: &Program,
+    machine: &Machine,
+    kin: &Kinematics,
+    width: Option<Width>,
+) -> Result<Frame, NcError> {
     let Some((origin, dir)) = kin.mandrel_axis() else {
         return Ok(Frame::Plan);
     };
@@ -256,6 +261,7 @@ pub fn frame_for(program: &Program, machine: &Machine, kin: &Kinematics, width: 
                     radius: r,
                     width: w,
                     axis: machine.mandrel_axis().unwrap_or(0),
+                    label: machine.mandrel_axis().map_or_else(String::new, |i| machine.axes[i].label.clone()),
                     origin,
                     direction: dir,
                 });
@@ -273,6 +279,16 @@ pub fn frame_for(program: &Program, machine: &Machine, kin: &Kinematics, width: 
 /// width narrower than [`MIN_WIDTH`] or wider than [`MAX_WIDTH_PER_SPAN`] times the laid part,
 /// and laid points on or near a mandrel's axis (see [`frame_for`]).
 pub fn footprints(program: &Program, machine: &Machine, width: Width) -> Result<Footprints, NcError> {
+    footprints_within(program, machine, width, MAX_PIECES)
+}
+
+/// [`footprints`] with at most about `max_pieces` rectangles (one more per laid move at most).
+pub(crate) fn footprints_within(
+    program: &Program,
+    machine: &Machine,
+    width: Width,
+    max_pieces: usize,
+) -> Result<Footprints, NcError> {
     let narrowest = match width {
         Width::Tow(t) | Width::Course(t) => t,
     };
@@ -339,24 +355,34 @@ pub fn footprints(program: &Program, machine: &Machine, width: Width) -> Result<
             });
         }
     }
-    // Pieces no longer than four widths, unless that makes more than MAX_PIECES in all.
-    let natural = |len: f64, w: f64, stretch: f64| -> usize {
-        let inner = len - OVERLAP_TOLERANCE;
-        ((inner / (4.0 * w.max(1e-3) * stretch)).ceil() as usize).clamp(1, 100_000)
-    };
+    // Pieces no longer than four widths (at most 100,000 per move), unless that makes more than
+    // `max_pieces` in all: then each move gets its share of them.
     let length = |(a, b): &([f64; 2], [f64; 2])| ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
-    let total: usize = laid
+    let natural: Vec<usize> = laid
         .iter()
         .zip(&mapped)
-        .filter(|(_, m)| length(m) > OVERLAP_TOLERANCE)
-        .map(|(l, m)| natural(length(m), l.2, 1.0))
-        .fold(0usize, |a, b| a.saturating_add(b));
-    let stretch = if total > MAX_PIECES { total as f64 / MAX_PIECES as f64 } else { 1.0 };
+        .map(|(l, m)| {
+            let inner = length(m) - OVERLAP_TOLERANCE;
+            if inner > 0.0 {
+                ((inner / (4.0 * l.2.max(1e-3))).ceil() as usize).clamp(1, 100_000)
+            } else {
+                0
+            }
+        })
+        .collect();
+    let total = natural.iter().fold(0usize, |a, &b| a.saturating_add(b));
+    let share = |n: usize| {
+        if total > max_pieces {
+            ((n as f64 * max_pieces as f64 / total as f64) as usize).max(1)
+        } else {
+            n
+        }
+    };
 
     let mut courses: Vec<Footprint> = vec![Footprint::default(); program.courses.len()];
     let mut path: Vec<[f64; 2]> = Vec::new();
     let mut prev: Option<(usize, usize)> = None;
-    for (&(c, i, w), &(a, b)) in laid.iter().zip(&mapped) {
+    for ((&(c, i, w), &(a, b)), &n) in laid.iter().zip(&mapped).zip(&natural) {
         // A new polyline where the course changes or a laid move does not follow the last one.
         let joined = prev.is_some_and(|(pc, pi)| pc == c && pi + 1 == i);
         if !joined {
@@ -371,7 +397,7 @@ pub fn footprints(program: &Program, machine: &Machine, width: Width) -> Result<
             path.push(a);
         }
         path.push(b);
-        add_quads_stretched(&mut courses[c], a, b, w, stretch);
+        add_pieces(&mut courses[c], a, b, w, share(n));
         prev = Some((c, i));
     }
     if let Some((pc, _)) = prev {
@@ -386,11 +412,14 @@ pub fn footprints(program: &Program, machine: &Machine, width: Width) -> Result<
 /// no longer than four widths (so spatial indexes stay tight).
 #[cfg(test)]
 fn add_quads(fp: &mut Footprint, a: [f64; 2], b: [f64; 2], w: f64) {
-    add_quads_stretched(fp, a, b, w, 1.0)
+    let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+    let pieces = (((len - OVERLAP_TOLERANCE) / (4.0 * w.max(1e-3))).ceil() as usize).clamp(1, 100_000);
+    add_pieces(fp, a, b, w, pieces)
 }
 
-/// Like `add_quads`, with pieces `stretch` (≥ 1) times longer.
-fn add_quads_stretched(fp: &mut Footprint, a: [f64; 2], b: [f64; 2], w: f64, stretch: f64) {
+/// Adds the shrunk rectangles of one laid move from `a` to `b` of width `w`, in `pieces`
+/// pieces of equal length (the whole move's rectangle goes to `moves`).
+fn add_pieces(fp: &mut Footprint, a: [f64; 2], b: [f64; 2], w: f64, pieces: usize) {
     let shrink = OVERLAP_TOLERANCE / 2.0;
     let d = [b[0] - a[0], b[1] - a[1]];
     let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
@@ -400,7 +429,7 @@ fn add_quads_stretched(fp: &mut Footprint, a: [f64; 2], b: [f64; 2], w: f64, str
     }
     let u = [d[0] / len, d[1] / len];
     let inner = len - OVERLAP_TOLERANCE;
-    let pieces = ((inner / (4.0 * w.max(1e-3) * stretch)).ceil() as usize).clamp(1, 100_000);
+    let pieces = pieces.max(1);
     let piece = inner / pieces as f64;
     let m = fp.moves.len() as u32;
     fp.moves.push(Quad { c: [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0], u, hl: inner / 2.0, hw });
@@ -458,6 +487,78 @@ mod tests {
         assert_eq!(a.quads.len(), 3);
         assert_eq!(a.moves.len(), 1);
         assert_eq!(a.move_of, vec![0, 0, 0]);
+    }
+
+    fn xyz() -> Machine {
+        use towpath_machine::{Axis, AxisKind};
+        Machine::new("m", ["X", "Y", "Z"].iter().map(|l| Axis::new(l, AxisKind::Linear)).collect()).unwrap()
+    }
+
+    /// One tow laid in a straight line from `a` to `b` (plan coordinates).
+    fn course(a: [f64; 2], b: [f64; 2]) -> String {
+        format!(
+            "G0 X{} Y{} Z10\nG1 Z0 F1000\nM20\nM60 P1\nG1 X{} Y{} F3000\nM61 P1\nM21\nG1 Z10\n",
+            a[0], a[1], b[0], b[1]
+        )
+    }
+
+    /// Capped at a few pieces, long moves are split into longer pieces that still make up
+    /// exactly each move, and precedence comes out the same.
+    #[test]
+    fn capped_pieces_still_make_up_each_move() {
+        let mut text = String::from("G90\n(PLY 1)\n");
+        for k in 0..4 {
+            text.push_str(&course([0.0, 10.0 * k as f64], [5000.0, 10.0 * k as f64]));
+        }
+        text.push_str("(PLY 2)\n");
+        for k in 0..4 {
+            text.push_str(&course([1000.0 * k as f64, -5.0], [1000.0 * k as f64 + 300.0, 40.0]));
+        }
+        let m = xyz();
+        let p = crate::parse::parse(&text, &m, &crate::Dialect::default()).unwrap();
+        let free = footprints(&p, &m, Width::Course(2.0)).unwrap();
+        let capped = footprints_within(&p, &m, Width::Course(2.0), 40).unwrap();
+        let count = |f: &Footprints| f.courses.iter().map(|c| c.quads.len()).sum::<usize>();
+        assert!(count(&free) > 2000, "{}", count(&free));
+        assert!(count(&capped) <= 40 + 8, "{}", count(&capped));
+        for (a, b) in free.courses.iter().zip(&capped.courses) {
+            assert_eq!(a.moves, b.moves);
+            for (mi, mv) in b.moves.iter().enumerate() {
+                let pieces: Vec<&Quad> =
+                    b.quads.iter().zip(&b.move_of).filter(|(_, &m)| m as usize == mi).map(|(q, _)| q).collect();
+                let total: f64 = pieces.iter().map(|q| 2.0 * q.hl).sum();
+                assert!((total - 2.0 * mv.hl).abs() < 1e-6, "{total} {}", 2.0 * mv.hl);
+                assert!(pieces.iter().all(|q| q.hw == mv.hw && q.u == mv.u));
+            }
+        }
+        let plies: Vec<Vec<usize>> = p.plies.iter().map(|p| p.courses.clone()).collect();
+        let mut e1 = crate::precedence::course_precedence(&free, &plies).unwrap();
+        let mut e2 = crate::precedence::course_precedence(&capped, &plies).unwrap();
+        e1.sort_unstable();
+        e2.sort_unstable();
+        assert_eq!(e1, e2);
+        assert!(!e1.is_empty());
+    }
+
+    /// Widths narrower than twice the overlap tolerance, or far wider than the part, are refused;
+    /// the bounds themselves are accepted.
+    #[test]
+    fn widths_are_checked_against_the_tolerance_and_the_part() {
+        let mut text = String::from("G90\n(PLY 1)\n");
+        text.push_str(&course([0.0, 0.0], [300.0, 0.0]));
+        text.push_str(&course([0.0, 40.0], [300.0, 40.0]));
+        let m = xyz();
+        let p = crate::parse::parse(&text, &m, &crate::Dialect::default()).unwrap();
+        // The laid paths span the diagonal of (0, 0)–(300, 40).
+        let span = (300.0f64 * 300.0 + 40.0 * 40.0).sqrt();
+        assert!(footprints(&p, &m, Width::Course(MAX_WIDTH_PER_SPAN * span * 0.999)).is_ok());
+        let e = footprints(&p, &m, Width::Course(MAX_WIDTH_PER_SPAN * span * 1.001)).unwrap_err();
+        assert!(matches!(e, NcError::ImplausibleWidth { .. }) && e.to_string().contains("302.655 mm in plan"), "{e}");
+        let e = footprints(&p, &m, Width::Course(1e20)).unwrap_err();
+        assert!(e.to_string().starts_with("a course width of 1e20 mm is more than 2 times"), "{e}");
+        assert!(footprints(&p, &m, Width::Tow(MIN_WIDTH)).is_ok());
+        let e = footprints(&p, &m, Width::Tow(MIN_WIDTH * 0.9)).unwrap_err();
+        assert!(e.to_string().contains("is narrower than 0.02 mm"), "{e}");
     }
 
     #[test]

@@ -17,7 +17,7 @@ pub const MAX_AXIS_VALUE: f64 = towpath_machine::MAX_AXIS_VALUE;
 
 /// Most chords a program's arcs may be split into (within [`ARC_CHORD_TOLERANCE`] each): the
 /// bound on the memory the moves of a program's arcs take.
-pub const MAX_ARC_CHORDS: usize = 2_000_000;
+pub const MAX_ARC_CHORDS: usize = 1_000_000;
 
 /// Words of an arc: centre offsets from the start (I along X, J along Y, K along Z) or radius.
 const ARC_WORDS: &str = "IJKR";

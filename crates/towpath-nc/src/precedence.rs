@@ -63,7 +63,7 @@ const MAX_DENSE_CELLS: i64 = 2_000_000;
 
 /// Most (rectangle, cell) incidences a grid may hold: the cells grow until the footprints' pieces
 /// touch no more than this many (so its memory stays bounded whatever the widths and lengths).
-pub(crate) const MAX_CELL_HITS: u64 = 8_000_000;
+pub const MAX_CELL_HITS: u64 = 8_000_000;
 
 /// Most grid entries a precedence search may visit before giving up (seconds of work): about 30
 /// times what the benchmark's 100-ply, 10,000-course panel needs for course precedence
@@ -152,8 +152,8 @@ pub(crate) struct CellHit {
 
 impl Grid {
     /// A grid with cells `factor` times the median rectangle width, or larger when the
-    /// footprints would touch more than [`MAX_CELL_HITS`] cells in all.
-    pub fn new(fps: &Footprints, factor: f64) -> Self {
+    /// footprints would touch more than `max_hits` cells in all.
+    pub fn new(fps: &Footprints, factor: f64, max_hits: u64) -> Self {
         let mut widths: Vec<f64> = fps.courses.iter().flat_map(|f| f.quads.iter().map(|q| 2.0 * q.hw)).collect();
         let mut size = if widths.is_empty() {
             1.0
@@ -177,13 +177,13 @@ impl Grid {
                 let nx = ((b[0] / size).floor() - (a[0] / size).floor() + 1.0).max(1.0);
                 let ny = ((b[1] / h).floor() - (a[1] / h).floor() + 1.0).max(1.0);
                 total = total.saturating_add((nx * ny).min(u64::MAX as f64 / 4.0) as u64);
-                if total > MAX_CELL_HITS {
+                if total > max_hits {
                     break;
                 }
             }
             total
         };
-        while hits(size) > MAX_CELL_HITS && size.is_finite() {
+        while hits(size) > max_hits && size.is_finite() {
             size *= 2.0;
         }
         let rows = rows_for(size);
@@ -311,16 +311,29 @@ const MAX_BITSET_COURSES: usize = 30_000;
 /// ([`NcError::WorkLimit`]) when the footprints are piled up so densely that the search would
 /// visit more than [`MAX_VISITS`] grid entries.
 pub fn course_precedence(fps: &Footprints, plies: &[Vec<usize>]) -> Result<Vec<(usize, usize)>, NcError> {
-    course_precedence_within(fps, plies, MAX_VISITS)
+    course_precedence_within(fps, plies, Limits::DEFAULT)
 }
 
-/// [`course_precedence`] under a visit budget.
+/// The work and memory bounds of the precedence searches.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Limits {
+    /// Grid entries a search may visit.
+    pub visits: u64,
+    /// (rectangle, cell) incidences a grid may hold.
+    pub hits: u64,
+}
+
+impl Limits {
+    pub(crate) const DEFAULT: Limits = Limits { visits: MAX_VISITS, hits: MAX_CELL_HITS };
+}
+
+/// [`course_precedence`] under `limits`.
 pub(crate) fn course_precedence_within(
     fps: &Footprints,
     plies: &[Vec<usize>],
-    limit: u64,
+    limits: Limits,
 ) -> Result<Vec<(usize, usize)>, NcError> {
-    let budget = Budget::new(limit);
+    let budget = Budget::new(limits.visits);
     let n = fps.courses.len();
     let mut ply_of = vec![0u32; n];
     for (p, cs) in plies.iter().enumerate() {
@@ -328,7 +341,7 @@ pub(crate) fn course_precedence_within(
             ply_of[c] = p as u32;
         }
     }
-    let grid = Grid::new(fps, 0.5);
+    let grid = Grid::new(fps, 0.5, limits.hits);
     let frame = fps.frame;
     let use_bits = n <= MAX_BITSET_COURSES;
     let mut anc: Vec<Bits> = if use_bits { (0..n).map(|_| Bits::default()).collect() } else { Vec::new() };
@@ -440,17 +453,17 @@ pub(crate) fn course_precedence_within(
 /// of the set's courses. Returns the sets as lists of plies. Refused like
 /// [`course_precedence`] beyond [`MAX_VISITS`] grid entries.
 pub fn precedence_sets(fps: &Footprints, plies: &[Vec<usize>]) -> Result<Vec<Vec<usize>>, NcError> {
-    precedence_sets_within(fps, plies, MAX_VISITS)
+    precedence_sets_within(fps, plies, Limits::DEFAULT)
 }
 
-/// [`precedence_sets`] under a visit budget.
+/// [`precedence_sets`] under `limits`.
 pub(crate) fn precedence_sets_within(
     fps: &Footprints,
     plies: &[Vec<usize>],
-    limit: u64,
+    limits: Limits,
 ) -> Result<Vec<Vec<usize>>, NcError> {
-    let budget = Budget::new(limit);
-    let grid = Grid::new(fps, 2.0);
+    let budget = Budget::new(limits.visits);
+    let grid = Grid::new(fps, 2.0, limits.hits);
     let frame = fps.frame;
     let mut sets: Vec<Vec<usize>> = Vec::new();
     let mut cells: CellStore<Vec<Entry>> = CellStore::new(&grid);
@@ -563,6 +576,86 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The pairs (a, b) with a in an earlier ply than b and overlapping it, by brute force.
+    fn relation(fps: &Footprints, ply_of: &dyn Fn(usize) -> usize) -> Vec<Vec<bool>> {
+        let n = fps.courses.len();
+        let mut r = vec![vec![false; n]; n];
+        for a in 0..n {
+            for b in 0..n {
+                r[a][b] = ply_of(a) < ply_of(b) && fps.courses[a].overlaps(&fps.courses[b], &fps.frame);
+            }
+        }
+        r
+    }
+
+    /// A grid budget far too small for the natural cells (0.5 median widths) grows the cells
+    /// instead of leaving rectangles out (before, a rectangle over more than 4,000,000 cells was
+    /// silently dropped from the grid): the edges' closure is still the brute-force relation,
+    /// and the grid holds no more incidences than allowed.
+    #[test]
+    fn a_small_cell_budget_grows_the_cells_and_keeps_the_relation() {
+        // Ply 0: thin bands 2 mm wide across x; ply 1: one huge band crossing some of them and
+        // thin bands; ply 2: thin bands over ply 1's.
+        let mut courses = Vec::new();
+        for k in 0..20 {
+            courses.push(band([0.0, 10.0 * k as f64], [300.0, 10.0 * k as f64], 2.0));
+        }
+        courses.push(band([100.0, -50.0], [100.0, 120.0], 40.0));
+        for k in 0..10 {
+            courses.push(band([150.0 + 10.0 * k as f64, 0.0], [150.0 + 10.0 * k as f64, 500.0], 2.0));
+        }
+        for k in 0..10 {
+            courses.push(band([145.0 + 10.0 * k as f64, 0.0], [155.0 + 10.0 * k as f64, 400.0], 2.0));
+        }
+        let plies: Vec<Vec<usize>> = vec![(0..20).collect(), (20..31).collect(), (31..41).collect()];
+        let ply_of = |c: usize| {
+            if c < 20 {
+                0
+            } else if c < 31 {
+                1
+            } else {
+                2
+            }
+        };
+        let fps = Footprints { frame: Frame::Plan, courses };
+        let want = relation(&fps, &ply_of);
+        assert!(want.iter().flatten().filter(|x| **x).count() > 20);
+        let small = Limits { visits: MAX_VISITS, hits: 60 };
+        let natural = Grid::new(&fps, 0.5, MAX_CELL_HITS);
+        let grown = Grid::new(&fps, 0.5, small.hits);
+        assert!(grown.size > 4.0 * natural.size, "{} {}", grown.size, natural.size);
+        for limits in [Limits::DEFAULT, small] {
+            let edges = course_precedence_within(&fps, &plies, limits).unwrap();
+            let r = closure(fps.courses.len(), &edges);
+            for (a, row) in want.iter().enumerate() {
+                for (b, &w) in row.iter().enumerate() {
+                    assert_eq!(r[a][b], w, "{a} -> {b} with {limits:?}");
+                }
+            }
+            let sets = precedence_sets_within(&fps, &plies, limits).unwrap();
+            assert_eq!(sets, vec![vec![0], vec![1], vec![2]]);
+        }
+    }
+
+    /// Footprints piled up by the hundred over one place: past the visit budget the searches
+    /// stop with a clear refusal instead of running on; within it they give the relation.
+    #[test]
+    fn searches_past_their_visit_budget_are_refused() {
+        let courses: Vec<Footprint> = (0..300).map(|k| band([0.0, 0.001 * k as f64], [100.0, 0.0], 10.0)).collect();
+        let plies: Vec<Vec<usize>> = vec![(0..150).collect(), (150..300).collect()];
+        let fps = Footprints { frame: Frame::Plan, courses };
+        let tight = Limits { visits: 10_000, hits: MAX_CELL_HITS };
+        let e = course_precedence_within(&fps, &plies, tight).unwrap_err();
+        assert!(matches!(e, NcError::WorkLimit { limit: 10_000, .. }), "{e}");
+        assert!(e.to_string().starts_with("course precedence: more than 10000 footprint comparisons"), "{e}");
+        let e = precedence_sets_within(&fps, &plies, Limits { visits: 100, hits: MAX_CELL_HITS }).unwrap_err();
+        assert!(e.to_string().starts_with("seed 000's precedence sets: more than 100"), "{e}");
+        let edges = course_precedence(&fps, &plies).unwrap();
+        let r = closure(300, &edges);
+        let want = relation(&fps, &|c| c / 150);
+        assert_eq!(r, want);
     }
 
     #[test]

@@ -9,8 +9,8 @@ use towpath_machine::{CostKind, Machine};
 use crate::footprint::{frame_for, Frame};
 use crate::optimize::{Optimized, SolverSummary, Timings};
 use crate::problem::PrecedenceRule;
-use crate::reverse::Irreversible;
 use crate::program::{ply_name, Program};
+use crate::reverse::Irreversible;
 use crate::verify::{Motion, Verification};
 
 /// Before/after figures under one cost model.
@@ -252,15 +252,7 @@ impl Report {
                 crate::width::WidthSource::Dialect => "the dialect".into(),
                 crate::width::WidthSource::Default => "none given".into(),
             },
-            warnings: o
-                .width
-                .warning
-                .iter()
-                .cloned()
-                .chain(o.afp.not_reversible.iter().filter(|(_, why)| !matches!(why, Irreversible::Other(_))).map(
-                    |(c, why)| format!("{} is laid forward only: {why}", p.course_name(*c)),
-                ))
-                .collect(),
+            warnings: o.width.warning.iter().cloned().chain(forward_only(p, &o.afp.not_reversible)).collect(),
         }
     }
 
@@ -419,6 +411,24 @@ impl Report {
         h.push_str("</body></html>\n");
         h
     }
+}
+
+/// One warning for the courses kept forward because of codes the dialect does not describe (or
+/// switches that do not pair up): how many, and the first.
+fn forward_only(p: &Program, not_reversible: &[(usize, Irreversible)]) -> Option<String> {
+    let list: Vec<&(usize, Irreversible)> =
+        not_reversible.iter().filter(|(_, why)| !matches!(why, Irreversible::Other(_))).collect();
+    let (c, why) = list.first()?;
+    Some(if list.len() == 1 {
+        format!("{} is laid forward only: {why}", p.course_name(*c))
+    } else {
+        format!(
+            "{} courses are laid forward only because of codes the dialect does not describe or switches that do \
+             not pair up; the first, {}: {why}",
+            list.len(),
+            p.course_name(*c)
+        )
+    })
 }
 
 fn esc(s: &str) -> String {

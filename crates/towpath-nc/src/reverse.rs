@@ -97,7 +97,12 @@ pub fn reverse_course(
 
 /// Like [`reverse_course`], but without writing the lines (`lines` is left empty): enough to
 /// know whether and how the course reverses.
-pub fn reversal_of(program: &Program, c: usize, machine: &Machine, dialect: &Dialect) -> Result<Reversed, Irreversible> {
+pub fn reversal_of(
+    program: &Program,
+    c: usize,
+    machine: &Machine,
+    dialect: &Dialect,
+) -> Result<Reversed, Irreversible> {
     reverse_span(program, c, machine, dialect, false)
 }
 
@@ -116,7 +121,14 @@ enum Still {
 fn still_line(lexed: Option<&Lexed>, line: &str, codes: &crate::dialect::Codes, modal: bool) -> Result<Still, String> {
     let Some(lexed) = lexed else { return Err(format!("{:?}", line.trim())) };
     let g_known = |v: f64| {
-        codes.rapid.iter().chain(&codes.feed).chain(&codes.arc_cw).chain(&codes.arc_ccw).chain(&codes.planes).any(|c| c.matches('G', v))
+        codes
+            .rapid
+            .iter()
+            .chain(&codes.feed)
+            .chain(&codes.arc_cw)
+            .chain(&codes.arc_ccw)
+            .chain(&codes.planes)
+            .any(|c| c.matches('G', v))
             || codes.absolute.matches('G', v)
             || codes.incremental.matches('G', v)
     };
@@ -125,7 +137,10 @@ fn still_line(lexed: Option<&Lexed>, line: &str, codes: &crate::dialect::Codes, 
     let is_switch = |v: f64| codes.switches.iter().any(|(on, off)| on.matches('M', v) || off.matches('M', v));
     // Words after a dwell, a point code or a switch code are their parameters.
     let parameters = non_motion
-        || lexed.words.iter().any(|x| x.letter == 'M' && (codes.point.iter().any(|c| c.matches('M', x.value)) || is_switch(x.value)));
+        || lexed
+            .words
+            .iter()
+            .any(|x| x.letter == 'M' && (codes.point.iter().any(|c| c.matches('M', x.value)) || is_switch(x.value)));
     let mut switch: Option<(usize, bool, usize)> = None;
     let mut unknown: Vec<String> = Vec::new();
     for (k, w) in lexed.words.iter().enumerate() {
@@ -407,8 +422,7 @@ fn unknown_words(lexed: &Lexed, line: &str, codes: &crate::dialect::Codes, it: &
             || l == codes.mask_word
             || it.axis_of(l).is_some()
     };
-    let words: Vec<&str> =
-        lexed.words.iter().filter(|w| !known(w)).filter_map(|w| line.get(w.span.clone())).collect();
+    let words: Vec<&str> = lexed.words.iter().filter(|w| !known(w)).filter_map(|w| line.get(w.span.clone())).collect();
     if words.is_empty() {
         format!("{:?}", line.trim())
     } else {

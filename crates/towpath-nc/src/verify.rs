@@ -840,7 +840,11 @@ fn check_precedence(orig: &Program, fps: &Footprints, order: &[Placement]) -> Re
                     for &(x, qx) in &entry.1 {
                         let px = orig.courses[x as usize].ply;
                         if px > pb
-                            && crate::precedence::quads_overlap(&fps.frame, q, &fps.courses[x as usize].quads[qx as usize])
+                            && crate::precedence::quads_overlap(
+                                &fps.frame,
+                                q,
+                                &fps.courses[x as usize].quads[qx as usize],
+                            )
                         {
                             return Err(VerifyError::Precedence {
                                 before: orig.course_name(b),
@@ -877,7 +881,9 @@ fn sets_of_courses(plies: &[Vec<usize>], fps: &Footprints) -> Result<Vec<usize>,
                     if visits > MAX_GRID_VISITS {
                         return Err(too_dense("finding seed 000's precedence sets"));
                     }
-                    if v.iter().any(|&(x, qx)| crate::precedence::quads_overlap(&fps.frame, q, &fps.courses[x].quads[qx])) {
+                    if v.iter()
+                        .any(|&(x, qx)| crate::precedence::quads_overlap(&fps.frame, q, &fps.courses[x].quads[qx]))
+                    {
                         meets = true;
                         break 'ply;
                     }

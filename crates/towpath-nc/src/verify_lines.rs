@@ -111,9 +111,11 @@ impl<'a> Reader<'a> {
                     event = true;
                 } else if Self::any(&c.point, l, v) {
                     point = true;
-                } else if let Some(s) = c.switches.iter().enumerate().find_map(|(i, (on, off))| {
-                    (on.matches(l, v) || off.matches(l, v)).then_some((i, on.matches(l, v)))
-                }) {
+                } else if let Some(s) =
+                    c.switches.iter().enumerate().find_map(|(i, (on, off))| {
+                        (on.matches(l, v) || off.matches(l, v)).then_some((i, on.matches(l, v)))
+                    })
+                {
                     switch = Some(s);
                     switches += 1;
                 } else {
@@ -318,7 +320,12 @@ fn forward_block(orig: &Program, oc: usize, opt: &Program, kc: usize) -> Option<
 fn reversed_block(opt: &Program, kc: usize, window: &Range<usize>) -> Range<usize> {
     let k = &opt.courses[kc];
     let first = opt.segments.get(window.start).filter(|_| !window.is_empty()).map(|s| s.line as usize);
-    let last = window.end.checked_sub(1).and_then(|i| opt.segments.get(i)).filter(|_| !window.is_empty()).map(|s| s.line as usize);
+    let last = window
+        .end
+        .checked_sub(1)
+        .and_then(|i| opt.segments.get(i))
+        .filter(|_| !window.is_empty())
+        .map(|s| s.line as usize);
     let start = first.map_or(k.on_part.start, |f| f.min(k.on_part.start));
     let end = last.map_or(k.on_part.end, |l| (l + 1).max(k.on_part.end));
     start..end
@@ -336,7 +343,9 @@ fn still_lines(
     for j in lines {
         let text = bare(&p.lines[j]);
         let station = p.segments[segs.clone()].iter().filter(|s| (s.line as usize) < j).count();
-        let refuse = |why: &str| Err(format!("original line {} ({text:?}) {why}, so the course may only be laid forward", j + 1));
+        let refuse = |why: &str| {
+            Err(format!("original line {} ({text:?}) {why}, so the course may only be laid forward", j + 1))
+        };
         match reader.kind(text) {
             Kind::Undescribed => return refuse("holds words the dialect does not describe"),
             Kind::Arc => return refuse("is an arc"),
@@ -362,7 +371,9 @@ fn switch_stretches(lines: &[(usize, String, usize, Kind)]) -> Result<Vec<(Strin
             }
             (false, Some(from)) => out.push((key, from, *station)),
             (true, Some(_)) => return Err(format!("line {} ({text:?}) switches on what is already on", j + 1)),
-            (false, None) => return Err(format!("line {} ({text:?}) switches off what the course did not switch on", j + 1)),
+            (false, None) => {
+                return Err(format!("line {} ({text:?}) switches off what the course did not switch on", j + 1))
+            }
         }
     }
     if let Some((key, _)) = open.into_iter().next() {
@@ -413,7 +424,8 @@ pub(crate) fn reversal_lines(
     // The same point lines, each at the mirrored point.
     let mut want: Vec<(String, usize)> =
         original.iter().filter(|l| l.3 == Kind::Point).map(|l| (l.1.clone(), n - l.2)).collect();
-    let mut have: Vec<(String, usize)> = written.iter().filter(|l| l.3 == Kind::Point).map(|l| (l.1.clone(), l.2)).collect();
+    let mut have: Vec<(String, usize)> =
+        written.iter().filter(|l| l.3 == Kind::Point).map(|l| (l.1.clone(), l.2)).collect();
     want.sort();
     have.sort();
     if want != have {
@@ -488,7 +500,10 @@ pub(crate) fn account(
                 b
             }
         };
-        if blocks.last().is_some_and(|l: &Range<usize>| block.start < l.end) || block.start < orig.header_end || block.end > footer_start {
+        if blocks.last().is_some_and(|l: &Range<usize>| block.start < l.end)
+            || block.start < orig.header_end
+            || block.end > footer_start
+        {
             return Err(VerifyError::ExtraLine {
                 line: block.start + 1,
                 text: bare(&opt.lines[block.start.min(len - 1)]).to_string(),
@@ -511,8 +526,13 @@ pub(crate) fn account(
     let mut markers_seen = vec![false; marker_lines.len()];
     // Copies of any ply comment may stand between courses (the rewriter repeats them where a ply
     // starts again).
-    let any_marker: Vec<&str> =
-        orig.plies.iter().filter(|p| !p.courses.is_empty()).filter_map(|p| p.line).map(|j| bare(&orig.lines[j])).collect();
+    let any_marker: Vec<&str> = orig
+        .plies
+        .iter()
+        .filter(|p| !p.courses.is_empty())
+        .filter_map(|p| p.line)
+        .map(|j| bare(&orig.lines[j]))
+        .collect();
     let first_ply_unmarked = orig.plies.first().is_some_and(|p| p.line.is_none() && !p.courses.is_empty());
     // Every line that travels with a course, exactly once (where is not checked: look-alike
     // courses may be matched either way round), and the original's transit lines, which the

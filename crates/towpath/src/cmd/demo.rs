@@ -45,6 +45,11 @@ pub struct Args {
     pub solver: SolverArgs,
 }
 
+/// The file the demo writes a part's machine to.
+fn machine_file(m: &towpath_machine::Machine) -> String {
+    format!("{}.toml", m.name)
+}
+
 /// Runs the demo.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let time_limit = super::solver_args::time_limit(args.time_limit)?;
@@ -85,9 +90,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         outln!(
             "Each program is planned badly on purpose: plies out of order, every course laid in the same direction.\n\
              The {} solver re-sequences the courses ({}, a course after the courses of earlier plies it overlaps),\n\
-             towpath rewrites only the off-part motion and verifies the result independently.\n",
+             towpath rewrites only the off-part motion and verifies the result independently.\n\
+             Course width: tow width {TOW_WIDTH} mm × tows on, from the demo's dialect ({}).\n",
             args.solver.solver,
-            if args.unidirectional { "unidirectional" } else { "bidirectional" }
+            if args.unidirectional { "unidirectional" } else { "bidirectional" },
+            dir.join("dialect.toml").display()
         );
         outln!(
             "{:<22} {:>7} {:>24} {:>8} {:>9} {:>13} {:>9}",
@@ -105,7 +112,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let prog_path = dir.join(format!("{}.nc", part.name));
         let out_path = dir.join(format!("{}.opt.nc", part.name));
         files.write(&prog_path, &part.program)?;
-        let o = optimize(&part.program, &part.machine, &dialect, &opts).map_err(|e| classify(&prog_path, e))?;
+        let o = optimize(&part.program, &part.machine, &dialect, &opts)
+            .map_err(|e| classify(&prog_path, &dir.join(machine_file(&part.machine)), e))?;
         files.write(&out_path, &o.text)?;
         let report = Report::new(&format!("{}.nc", part.name), &part.machine, &o, &afp);
         let optimized = parse(&o.text, &part.machine, &dialect)?;
@@ -147,7 +155,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     files.write(&manifest_path, manifest_text)?;
     files.commit()?;
     if args.json {
-        outln!("{}", serde_json::json!({ "dir": dir, "parts": rows }));
+        let width =
+            serde_json::json!({ "tow_width": TOW_WIDTH, "from": "dialect", "dialect": dir.join("dialect.toml") });
+        outln!("{}", serde_json::json!({ "dir": dir, "width": width, "parts": rows }));
     } else {
         outln!(
             "\nOpen {}/planar-45.html for a before/after plan view. To run one part yourself:\n  \

@@ -6,7 +6,7 @@ use std::time::Duration;
 use towpath_machine::CostKind;
 use towpath_nc::{optimize, AfpOptions, NcError, OptimizeOptions, PrecedenceRule, Report};
 
-use super::afp_common::{read, MachineArgs};
+use super::afp_common::{lines_with, machine_hint, read, warn, width_from, MachineArgs};
 use super::solver_args::SolverArgs;
 use crate::files::Files;
 use crate::{exit, outln};
@@ -59,13 +59,15 @@ pub struct Args {
     pub solver: SolverArgs,
 }
 
-/// Maps an optimization error to an exit code, naming the program file.
-pub fn classify(file: &std::path::Path, e: NcError) -> anyhow::Error {
+/// Maps an optimization error to an exit code, naming the program file (and the machine file
+/// where the error lies in it).
+pub fn classify(file: &std::path::Path, machine: &std::path::Path, e: NcError) -> anyhow::Error {
+    let hint = machine_hint(&e, machine);
     match e {
         NcError::SelfCheck(_) => exit::check_failed(anyhow::anyhow!("{}: {e}", file.display())),
         // Everything else, a solver that cannot take this program (`NcError::Solver`) included,
         // refuses the input.
-        _ => exit::bad_input(anyhow::anyhow!("{}: {e}", file.display())),
+        _ => exit::bad_input(anyhow::anyhow!("{}: {e}{hint}", file.display())),
     }
 }
 
@@ -93,7 +95,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (Some(t), _) => Some(t),
         (None, Some(_)) => None,
         (None, None) => Some({
-            let courses = text.lines().filter(|l| l.contains(dialect.contact_on.as_str())).count().max(1);
+            let courses = lines_with(&text, dialect.contact_on.as_str()).max(1);
             towpath_nc::auto_time_limit(if dialect.contact_on.is_empty() { 1000 } else { courses })
         }),
     };
@@ -114,7 +116,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         solver: args.solver.solver,
         baselines: args.solver.params(),
     };
-    let o = optimize(&text, &machine, &dialect, &opts).map_err(|e| classify(&args.program, e));
+    let o = optimize(&text, &machine, &dialect, &opts).map_err(|e| classify(&args.program, &args.machine.machine, e));
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -122,11 +124,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     files.write(&args.output, &o.text)?;
     let name =
         args.program.file_name().map_or_else(|| args.program.display().to_string(), |n| n.to_string_lossy().into());
-    let report = Report::new(&name, &machine, &o, &afp);
+    let mut report = Report::new(&name, &machine, &o, &afp);
+    report.width_from = width_from(&args.machine, &o.width, &args.machine.dialect_name());
+    for w in &report.warnings {
+        warn(w);
+    }
     if let Some(path) = &args.report {
         let body = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("html") || e.eq_ignore_ascii_case("htm"))
         {
-            let optimized = towpath_nc::parse(&o.text, &machine, &dialect).map_err(|e| classify(&args.output, e))?;
+            let optimized = towpath_nc::parse(&o.text, &machine, &dialect)
+                .map_err(|e| classify(&args.output, &args.machine.machine, e))?;
             report.to_html(&o, &optimized, &machine)
         } else {
             serde_json::to_string_pretty(&report)?
