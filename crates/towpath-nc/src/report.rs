@@ -248,9 +248,9 @@ impl Report {
             fell_back: o.fell_back,
             width: o.width.clone(),
             width_from: match o.width.source {
-                crate::width::WidthSource::Given => "given with the run".into(),
+                crate::width::WidthSource::Given => "the options given".into(),
                 crate::width::WidthSource::Dialect => "the dialect".into(),
-                crate::width::WidthSource::Default => "none given".into(),
+                crate::width::WidthSource::Default => "nowhere".into(),
             },
             warnings: o.width.warning.iter().cloned().chain(forward_only(p, &o.afp.not_reversible)).collect(),
         }

@@ -282,7 +282,16 @@ pub(crate) fn check_header_footer(orig: &Program, opt: &Program) -> Result<(), V
     }
     // Align from the end: the last footer line that differs.
     let i = (0..n).rev().find(|&i| k[off + i] != footer[i]).unwrap_or(0);
-    Err(difference(&o, &k, orig.footer_start + i, off + i, "in the footer"))
+    let (oj, kj) = (orig.footer_start + i, off + i);
+    // Read backwards: the optimized line is the original's line before (one is missing), or
+    // the original line is the optimized line before (one was added), or it is changed.
+    if oj > 0 && o.get(oj - 1) == k.get(kj) {
+        return Err(VerifyError::LostLine { line: oj + 1, text: o[oj].to_string() });
+    }
+    if kj > 0 && k.get(kj - 1) == o.get(oj) {
+        return Err(VerifyError::ExtraLine { line: kj + 1, text: k[kj].to_string(), place: "in the footer".into() });
+    }
+    Err(difference(&o, &k, oj, kj, "in the footer"))
 }
 
 /// The error for original line `oj` against optimized line `kj` where they first differ.
