@@ -38,7 +38,7 @@ pub use optimize::{apply_steps, auto_time_limit, optimize, OptimizeOptions, Opti
 pub use parse::parse;
 pub use precedence::{course_precedence, precedence_sets, MAX_VISITS};
 pub use problem::{build_problem, placements, AfpOptions, AfpProblem, PrecedenceRule};
-pub use program::{ply_name, Course, Item, LineBreak, Ply, Program, Region, Segment};
+pub use program::{ply_name, Course, Item, LineBreak, Ply, Program, Region, Segment, SwitchKey};
 pub use report::{totals, GroupCost, GroupRow, OrderRow, Report, Totals};
 pub use reverse::{reversal_of, reverse_course, Irreversible, Reversed};
 pub use rewrite::{rewrite, Placement};

@@ -263,6 +263,25 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
         snaps[p].1.clone()
     };
 
+    // The dialect's switches on where each span starts.
+    let mut switches_on: Vec<Vec<crate::program::SwitchKey>> = vec![Vec::new(); k];
+    if !codes.switches.is_empty() {
+        let mut on: Vec<crate::program::SwitchKey> = Vec::new();
+        let mut c = 0;
+        for (j, line) in lines.iter().enumerate() {
+            while c < k && span_start[c] == j {
+                switches_on[c] = on.clone();
+                c += 1;
+            }
+            if let Some((key, is_on)) = crate::reverse::switch_of(line, dialect, &codes) {
+                on.retain(|x| *x != key);
+                if is_on {
+                    on.push(key);
+                    on.sort();
+                }
+            }
+        }
+    }
     let seg_index = |line: usize| segments.partition_point(|s| (s.line as usize) < line);
     let mut courses = Vec::with_capacity(k);
     for c in 0..k {
@@ -279,6 +298,7 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
             insert: snap(insert_at[c]),
             span_start: snap(span_start[c]),
             exit: snap(span_end[c]),
+            switches_on: std::mem::take(&mut switches_on[c]),
         });
     }
     Ok(Program {

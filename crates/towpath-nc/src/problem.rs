@@ -118,6 +118,7 @@ pub fn build_problem(
     opts: &AfpOptions,
 ) -> Result<AfpProblem, NcError> {
     let k = program.courses.len();
+    crate::reverse::check_switch_scope(program, dialect)?;
     let plies: Vec<Vec<usize>> = program.plies.iter().map(|p| p.courses.clone()).collect();
     let plies_with_courses = plies.iter().filter(|p| !p.is_empty()).count();
     let width = opts.width_or(dialect);

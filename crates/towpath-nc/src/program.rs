@@ -29,6 +29,10 @@ pub struct Segment {
     pub on_part: bool,
 }
 
+/// A switch of the dialect (its index among the dialect's switches) and the words written
+/// with its code (`M64 P3` and `M65 P3` are one switch, `M64 P4` another).
+pub type SwitchKey = (usize, Vec<(char, String)>);
+
 /// A line kept with a course outside its span: an original line, or text towpath kept from a
 /// transit line whose motion it regenerates (comments and words it does not understand).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -79,6 +83,9 @@ pub struct Course {
     pub span_start: Modal,
     /// The machine state after the span.
     pub exit: Modal,
+    /// The dialect's switches on where the span starts, reading the program in its order
+    /// (sorted; empty without switches in the dialect).
+    pub switches_on: Vec<SwitchKey>,
 }
 
 impl Course {

@@ -52,9 +52,7 @@ enum StationItem {
     Switch(SwitchKey, bool, String, usize),
 }
 
-/// A switch and the words that come with its code (`M64 P3` and `M65 P3` are one switch,
-/// `M64 P4` another).
-type SwitchKey = (usize, Vec<(char, String)>);
+use crate::program::SwitchKey;
 
 /// Why a course cannot be laid reversed (it is then laid forward only, and the report says why).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -187,6 +185,98 @@ fn still_line(lexed: Option<&Lexed>, line: &str, codes: &crate::dialect::Codes, 
     }
 }
 
+/// The switch a line turns on or off, with its words: a line with one switch code of the
+/// dialect (its other words, line number aside, name which switch). `None` for other lines.
+pub(crate) fn switch_of(line: &str, dialect: &Dialect, codes: &crate::dialect::Codes) -> Option<(SwitchKey, bool)> {
+    if codes.switches.is_empty() {
+        return None;
+    }
+    let lexed = crate::lex::lex(line.trim_end_matches('\r'), dialect.comment_parens, dialect.comment_semicolon).ok()?;
+    let mut found = None;
+    for (k, w) in lexed.words.iter().enumerate() {
+        if w.letter != 'M' {
+            continue;
+        }
+        if let Some(x) = codes.switches.iter().enumerate().find_map(|(i, (on, off))| {
+            (on.matches('M', w.value) || off.matches('M', w.value)).then_some((i, on.matches('M', w.value), k))
+        }) {
+            found = Some(x);
+        }
+    }
+    let (i, on, k) = found?;
+    let words = lexed
+        .words
+        .iter()
+        .enumerate()
+        .filter(|&(x, w)| x != k && w.letter != codes.line_number_word)
+        .map(|(_, w)| (w.letter, w.text.to_string()))
+        .collect();
+    Some(((i, words), on))
+}
+
+/// Checks that the courses may be laid in any order without changing which switches of the
+/// dialect are on where: every course, with the lines that travel with it, leaves each switch
+/// as it found it (a switch turned on before a course's approach is turned off again after its
+/// retract, before the next course; or it is left to the header and footer). Refused otherwise,
+/// naming the line that leaves a switch on (or off) for the courses after it.
+pub(crate) fn check_switch_scope(program: &Program, dialect: &Dialect) -> Result<(), crate::error::NcError> {
+    let codes = dialect.codes()?;
+    if codes.switches.is_empty() {
+        return Ok(());
+    }
+    let apply = |state: &mut Vec<SwitchKey>, text: &str| -> Option<bool> {
+        let (key, on) = switch_of(text, dialect, &codes)?;
+        let had = state.contains(&key);
+        state.retain(|k| *k != key);
+        if on {
+            state.push(key);
+        }
+        Some(had != on)
+    };
+    let mut base: Vec<SwitchKey> = Vec::new();
+    for line in &program.lines[..program.header_end] {
+        apply(&mut base, line);
+    }
+    base.sort();
+    for course in &program.courses {
+        let mut state = base.clone();
+        let mut last: Option<(usize, String)> = None;
+        let mut step = |j: usize, text: &str, state: &mut Vec<SwitchKey>| {
+            if apply(state, text).is_some() {
+                last = Some((j, text.trim_end_matches('\r').to_string()));
+            }
+        };
+        for item in course.pre_before.iter().chain(&course.pre_after) {
+            match item {
+                crate::program::Item::Line(j) => step(*j, &program.lines[*j], &mut state),
+                crate::program::Item::Kept(j, t) => step(*j, t, &mut state),
+            }
+        }
+        for j in course.span.clone() {
+            step(j, &program.lines[j], &mut state);
+        }
+        for item in &course.post {
+            match item {
+                crate::program::Item::Line(j) => step(*j, &program.lines[*j], &mut state),
+                crate::program::Item::Kept(j, t) => step(*j, t, &mut state),
+            }
+        }
+        state.sort();
+        if state != base {
+            let (j, text) = last.unwrap_or((course.span.start, String::new()));
+            return Err(crate::error::NcError::line(
+                j + 1,
+                format!(
+                    "{text:?} leaves a switch {on} for the courses after it: laid in another order, other courses \
+                     would run with it {on}; switch it back within the course (or in the header and footer)",
+                    on = if state.iter().any(|k| !base.contains(k)) { "on" } else { "off" },
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn reverse_span(
     program: &Program,
     c: usize,
@@ -282,6 +372,18 @@ fn reverse_span(
         }
     }
     pair_switches(&mut stations)?;
+    // A switch already on where the course starts and switched within it would not be on along
+    // the same stretch reversed (its on and off lines trade places assuming it starts off).
+    for item in stations.iter().flatten() {
+        if let StationItem::Switch(key, _, text, j) = item {
+            if course.switches_on.contains(key) {
+                return Err(Irreversible::Switch {
+                    line: j + 1,
+                    problem: format!("{:?} switches what is already on where the course starts", text.trim()),
+                });
+            }
+        }
+    }
 
     // The heading shift.
     let mut shift = 0.0;

@@ -188,15 +188,17 @@ pub fn verify_parsed(
     let tol = (0.5 * 10f64.powi(-(dialect.decimals as i32))).max(1e-6);
     crate::verify_lines::check_header_footer(orig, opt)?;
     let order = match_courses(orig, opt, machine, dialect, tol)?;
-    // The moves of each reversed course, for its lines.
+    // The moves of each course (reversed, the original's retract leads), for its lines.
     let windows: Vec<Option<std::ops::Range<usize>>> = order
         .iter()
         .enumerate()
         .map(|(kc, p)| {
-            p.reversed.then(|| {
-                let a = span_motion(orig, p.course);
+            let a = span_motion(orig, p.course);
+            if p.reversed {
                 window_range(opt, kc, a.trail, a.lead)
-            })?
+            } else {
+                window_range(opt, kc, a.lead, a.trail)
+            }
         })
         .collect();
     crate::verify_lines::account(orig, opt, &order, &windows, dialect, machine)?;
@@ -491,7 +493,7 @@ fn is_reversal(
         }
     }
     let range = window_range(opt, kc, a.trail, a.lead).unwrap_or(0..0);
-    crate::verify_lines::reversal_lines(orig, oc, opt, kc, range, dialect, machine)
+    crate::verify_lines::rewritten_lines(orig, oc, opt, kc, range, true, dialect, machine)
 }
 
 fn same_value(machine: &Machine, i: usize, a: f64, b: f64, turn: f64, tol: f64) -> bool {

@@ -324,9 +324,9 @@ fn forward_block(orig: &Program, oc: usize, opt: &Program, kc: usize) -> Option<
     (end <= opt.lines.len()).then_some(start..end)
 }
 
-/// The lines of optimized course `kc` laid reversed: from its first move in `window` (segment
+/// The lines of optimized course `kc` written anew: from its first move in `window` (segment
 /// indices) or its on-part block, whichever comes first, to the last.
-fn reversed_block(opt: &Program, kc: usize, window: &Range<usize>) -> Range<usize> {
+fn rewritten_block(opt: &Program, kc: usize, window: &Range<usize>) -> Range<usize> {
     let k = &opt.courses[kc];
     let first = opt.segments.get(window.start).filter(|_| !window.is_empty()).map(|s| s.line as usize);
     let last = window
@@ -392,16 +392,18 @@ fn switch_stretches(lines: &[(usize, String, usize, Kind)]) -> Result<Vec<(Strin
     Ok(out)
 }
 
-/// Checks the lines of optimized course `kc` as a legal reversal of original course `oc`, its
-/// moves being `window` (segment indices of `opt`, already checked point by point): nothing but
-/// moves, tow and contact lines, and the original's point and switch lines at the mirrored
-/// points; and the original span holds nothing the dialect does not describe.
-pub(crate) fn reversal_lines(
+/// Checks the lines of optimized course `kc` as original course `oc` written anew, reversed or
+/// (a reversal reversed again) forward, its moves being `window` (segment indices of `opt`,
+/// already checked point by point): nothing but moves, tow and contact lines, and the
+/// original's point and switch lines at the same points (mirrored if reversed), switches on
+/// along the same stretches; and the original span holds nothing the dialect does not describe.
+pub(crate) fn rewritten_lines(
     orig: &Program,
     oc: usize,
     opt: &Program,
     kc: usize,
     window: Range<usize>,
+    reversed: bool,
     dialect: &Dialect,
     machine: &Machine,
 ) -> Result<(), String> {
@@ -409,7 +411,8 @@ pub(crate) fn reversal_lines(
     let course = &orig.courses[oc];
     let n = course.segments.len();
     let original = still_lines(&reader, orig, course.span.clone(), &course.segments)?;
-    let block = reversed_block(opt, kc, &window);
+    let block = rewritten_block(opt, kc, &window);
+    let at = |s: usize| if reversed { n - s } else { s };
     let mut written = Vec::new();
     for j in block.clone() {
         let text = bare(&opt.lines[j]);
@@ -423,8 +426,8 @@ pub(crate) fn reversal_lines(
             Kind::Empty => written.push((j, text.to_string(), station, Kind::Point)),
             _ => {
                 return Err(format!(
-                    "optimized line {} ({text:?}) is no part of a reversal (moves, tow and contact codes, and the \
-                     course's own comments, point codes and switches)",
+                    "optimized line {} ({text:?}) is no part of a course written anew (moves, tow and contact \
+                     codes, and the course's own comments, point codes and switches)",
                     j + 1
                 ))
             }
@@ -432,7 +435,7 @@ pub(crate) fn reversal_lines(
     }
     // The same point lines, each at the mirrored point.
     let mut want: Vec<(String, usize)> =
-        original.iter().filter(|l| l.3 == Kind::Point).map(|l| (l.1.clone(), n - l.2)).collect();
+        original.iter().filter(|l| l.3 == Kind::Point).map(|l| (l.1.clone(), at(l.2))).collect();
     let mut have: Vec<(String, usize)> =
         written.iter().filter(|l| l.3 == Kind::Point).map(|l| (l.1.clone(), l.2)).collect();
     want.sort();
@@ -440,17 +443,18 @@ pub(crate) fn reversal_lines(
     if want != have {
         let missing = want.iter().find(|w| !have.contains(w));
         return Err(match missing {
-            Some((t, s)) => format!("the original's line {t:?} is not at the mirrored point (after reversed move {s})"),
+            Some((t, s)) => format!("the original's line {t:?} is not at its point (after move {s} of the course)"),
             None => "it holds comment or point lines the original's course does not".into(),
         });
     }
     // The same switches, on along the mirrored stretches.
     let a = switch_stretches(&original).map_err(|e| format!("original {e}"))?;
     let b = switch_stretches(&written).map_err(|e| format!("optimized {e}"))?;
-    let mut mirrored: Vec<(String, usize, usize)> = a.into_iter().map(|(k, f, t)| (k, n - t, n - f)).collect();
+    let mut mirrored: Vec<(String, usize, usize)> =
+        a.into_iter().map(|(k, f, t)| if reversed { (k, n - t, n - f) } else { (k, f, t) }).collect();
     mirrored.sort();
     if mirrored != b {
-        return Err("its switches are not on along the stretches the original's are, reversed".into());
+        return Err("its switches are not on along the stretches the original's are".into());
     }
     // Every switch line of the original is written (switch texts trade places within a pair).
     let count = |v: &[(usize, String, usize, Kind)]| {
@@ -484,29 +488,46 @@ pub(crate) fn account(
     for (kc, p) in order.iter().enumerate() {
         let name = || orig.course_name(p.course);
         let block = match (&windows[kc], p.reversed) {
-            (Some(w), true) => reversed_block(opt, kc, w),
-            _ => {
-                let Some(b) = forward_block(orig, p.course, opt, kc) else {
-                    return Err(VerifyError::LostLine {
-                        line: orig.courses[p.course].span.start + 1,
-                        text: bare(&orig.lines[orig.courses[p.course].span.start]).to_string(),
-                    });
+            (Some(w), true) => rewritten_block(opt, kc, w),
+            (w, _) => {
+                let span = orig.courses[p.course].span.clone();
+                let o: Vec<&str> = orig.lines[span.clone()].iter().map(|l| bare(l)).collect();
+                let b = forward_block(orig, p.course, opt, kc);
+                let differs = match &b {
+                    Some(b) => {
+                        let k: Vec<&str> = opt.lines[b.clone()].iter().map(|l| bare(l)).collect();
+                        (0..o.len()).find(|&i| o[i] != k[i])
+                    }
+                    None => Some(0),
                 };
-                let o: Vec<&str> = orig.lines[orig.courses[p.course].span.clone()].iter().map(|l| bare(l)).collect();
-                let k: Vec<&str> = opt.lines[b.clone()].iter().map(|l| bare(l)).collect();
-                if let Some(i) = (0..o.len()).find(|&i| o[i] != k[i]) {
-                    // Compare the whole optimized course with the original span to name the line.
-                    let all: Vec<&str> = opt.lines.iter().map(|l| bare(l)).collect();
-                    let orig_all: Vec<&str> = orig.lines.iter().map(|l| bare(l)).collect();
-                    return Err(difference(
-                        &orig_all,
-                        &all,
-                        orig.courses[p.course].span.start + i,
-                        b.start + i,
-                        &format!("in {}", name()),
-                    ));
+                // Written anew forward (a reversal reversed again), by the rules of a reversal.
+                let anew = || {
+                    w.as_ref().is_some_and(|w| {
+                        rewritten_lines(orig, p.course, opt, kc, w.clone(), false, dialect, machine).is_ok()
+                    })
+                };
+                match (b, differs) {
+                    (Some(b), None) => b,
+                    (_, Some(_)) if anew() => rewritten_block(opt, kc, w.as_ref().unwrap_or(&(0..0))),
+                    (Some(b), Some(i)) => {
+                        // Name the first line where the optimized course and the original differ.
+                        let all: Vec<&str> = opt.lines.iter().map(|l| bare(l)).collect();
+                        let orig_all: Vec<&str> = orig.lines.iter().map(|l| bare(l)).collect();
+                        return Err(difference(
+                            &orig_all,
+                            &all,
+                            span.start + i,
+                            b.start + i,
+                            &format!("in {}", name()),
+                        ));
+                    }
+                    (None, _) => {
+                        return Err(VerifyError::LostLine {
+                            line: span.start + 1,
+                            text: o.first().unwrap_or(&"").to_string(),
+                        })
+                    }
                 }
-                b
             }
         };
         if blocks.last().is_some_and(|l: &Range<usize>| block.start < l.end)
@@ -604,6 +625,61 @@ pub(crate) fn account(
     }
     if let Some((j, alts)) = need.iter().zip(&used).filter(|(_, u)| !**u).map(|(n, _)| n).min_by_key(|n| n.0) {
         return Err(VerifyError::LostLine { line: j + 1, text: alts.last().copied().unwrap_or("").to_string() });
+    }
+    // Each course runs with the switches on that it ran with in the original, and so does the
+    // footer.
+    let states = |p: &Program| {
+        let mut on: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
+        let mut before = Vec::with_capacity(p.lines.len() + 1);
+        for l in &p.lines {
+            before.push(on.clone());
+            if let Kind::Switch(key, is_on) = reader.kind(bare(l)) {
+                let key = format!("{key:?}");
+                if is_on {
+                    on.insert(key);
+                } else {
+                    on.remove(&key);
+                }
+            }
+        }
+        before.push(on);
+        before
+    };
+    if !reader.codes.switches.is_empty() {
+        let (a, b) = (states(orig), states(opt));
+        for (kc, p) in order.iter().enumerate() {
+            let span = orig.courses[p.course].span.clone();
+            let want = &a[span.start];
+            let have = &b[blocks[kc].start];
+            if p.reversed {
+                // Reversed, a switch turned on and off within the course must be off where it starts.
+                if let Some(key) = span.clone().find_map(|j| match reader.kind(bare(&orig.lines[j])) {
+                    Kind::Switch(key, _) => Some(format!("{key:?}")).filter(|k| want.contains(k)),
+                    _ => None,
+                }) {
+                    return Err(VerifyError::Order(format!(
+                        "{} is laid reversed, but it switches {key} which is on where it starts: reversed, that \
+                         switch would not be on along the same stretch",
+                        orig.course_name(p.course)
+                    )));
+                }
+            }
+            if want != have {
+                return Err(VerifyError::Order(format!(
+                    "{} is laid with the switches {:?} on (optimized line {}), the original with {:?}",
+                    orig.course_name(p.course),
+                    have,
+                    blocks[kc].start + 1,
+                    want
+                )));
+            }
+        }
+        if a[orig.footer_start] != b[footer_start] {
+            return Err(VerifyError::Order(format!(
+                "the footer runs with the switches {:?} on, the original's with {:?}",
+                b[footer_start], a[orig.footer_start]
+            )));
+        }
     }
     if let Some(m) = markers_seen.iter().position(|s| !s) {
         return Err(VerifyError::LostLine { line: marker_lines[m] + 1, text: marker_texts[m].to_string() });

@@ -9,8 +9,8 @@ use std::collections::BTreeMap;
 use towpath_machine::{Axis, AxisKind, Machine};
 use towpath_nc::demo::{demo_parts, TOW_WIDTH};
 use towpath_nc::{
-    build_problem, optimize, parse, reverse_course, rewrite, verify, AfpOptions, Dialect, Irreversible,
-    NcError, OptimizeOptions, Placement, PrecedenceRule, Program, Report, Switch, VerifyError, VerifyOptions, Width,
+    build_problem, optimize, parse, reverse_course, rewrite, verify, AfpOptions, Dialect, Irreversible, NcError,
+    OptimizeOptions, Placement, PrecedenceRule, Program, Report, Switch, VerifyError, VerifyOptions, Width,
     WidthSource,
 };
 
@@ -127,7 +127,8 @@ fn laid_points_on_or_near_the_mandrel_axis_are_refused() {
         }
         assert!(e.to_string().contains("origin and direction of the machine's mandrel axis A"), "{e}");
         // The verifier builds the same footprints and refuses the same way.
-        let v = verify(&text, &text, &part.machine, &d, &VerifyOptions { width: opts.width, ..VerifyOptions::default() });
+        let v =
+            verify(&text, &text, &part.machine, &d, &VerifyOptions { width: opts.width, ..VerifyOptions::default() });
         assert!(matches!(v, Err(VerifyError::Setup(NcError::MandrelAxis { .. }))), "{v:?}");
         // Ply by ply needs no footprints, so nothing is unrolled and nothing refused.
         let plies = AfpOptions { precedence: PrecedenceRule::Plies, ..opts.clone() };
@@ -213,10 +214,7 @@ fn switches_pair_by_their_words_and_point_codes_stay_at_their_point() {
     let out = rewrite(&p, &order, &m, &d, &rev).unwrap();
     let pairs = [("M64", "M65")];
     let q = parse(&out, &m, &d).unwrap();
-    assert_eq!(
-        switched_on_along_laid_moves(&text, &p, &pairs),
-        switched_on_along_laid_moves(&out, &q, &pairs)
-    );
+    assert_eq!(switched_on_along_laid_moves(&text, &p, &pairs), switched_on_along_laid_moves(&out, &q, &pairs));
     // M0 at the same machine point: where the move before it ends (read from each text).
     let points = |p: &Program| {
         let mut v: Vec<String> = (0..p.lines.len())
@@ -237,6 +235,37 @@ fn switches_pair_by_their_words_and_point_codes_stay_at_their_point() {
     let left_on = text.replacen("M65 P4\n", "", 1);
     let p = parse(&left_on, &m, &d).unwrap();
     assert!(matches!(reverse_course(&p, 0, &m, &d), Err(Irreversible::Switch { .. })));
+}
+
+/// A switch turned on between courses and left on for the courses after it would run other
+/// courses with it on in another order: the optimizer refuses, naming the line, and the
+/// verifier refuses an order that changes which switches a course runs with. Turned off again
+/// around one course (or in the header and footer), the courses may move.
+#[test]
+fn switches_left_on_between_courses_are_refused() {
+    let m = gantry();
+    let d = Dialect { switches: vec![Switch { on: "M8".into(), off: "M9".into() }], ..Dialect::default() };
+    // Switched on before course 2 of ply 1 (travelling with it), never off.
+    let text = program("", "").replacen("(COURSE 2)\n", "(COURSE 2)\nM8 (heater on)\n", 1);
+    let line = text.lines().position(|l| l.starts_with("M8")).unwrap() + 1;
+    let e = optimize(&text, &m, &d, &opts(true)).unwrap_err();
+    assert!(
+        matches!(&e, NcError::Line { line: l, message } if *l == line && message.contains("leaves a switch on")),
+        "{e}"
+    );
+    // Course 1 (in the original laid with the heater off) moved after course 2: refused.
+    let p = parse(&text, &m, &d).unwrap();
+    let order: Vec<Placement> = [1, 0, 2, 3, 4].iter().map(|&course| Placement { course, reversed: false }).collect();
+    let out = rewrite(&p, &order, &m, &d, &[]).unwrap();
+    let e = verify(&text, &out, &m, &d, &vopts()).unwrap_err();
+    assert!(matches!(&e, VerifyError::Order(w) if w.contains("switches")), "{e}");
+    // Switched off again after course 2 (before the next course's comment, so travelling with
+    // course 2 too): the courses may move, and that order verifies.
+    let balanced = text.replacen("(COURSE 3)\n", "M9 (heater off)\n(COURSE 3)\n", 1);
+    let o = optimize(&balanced, &m, &d, &opts(true)).unwrap();
+    verify(&balanced, &o.text, &m, &d, &vopts()).unwrap();
+    let p = parse(&balanced, &m, &d).unwrap();
+    verify(&balanced, &rewrite(&p, &order, &m, &d, &[]).unwrap(), &m, &d, &vopts()).unwrap();
 }
 
 /// The verifier accounts for every line: a stop or a dwell slipped into a course, a line slipped
