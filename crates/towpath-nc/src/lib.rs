@@ -34,12 +34,12 @@ pub use footprint::{
 };
 pub use interp::{Event, Interp, Marker, Modal};
 pub use lex::{lex, LexIssue, Lexed, NumText, Word};
-pub use optimize::{apply_steps, auto_time_limit, optimize, OptimizeOptions, Optimized, SolverSummary, Timings};
+pub use optimize::{apply_steps, auto_time_limit, fallback_reason, optimize, Fallback, OptimizeOptions, Optimized, SolverSummary, Timings};
 pub use parse::parse;
 pub use precedence::{course_precedence, precedence_sets, MAX_VISITS};
-pub use problem::{build_problem, placements, AfpOptions, AfpProblem, PrecedenceRule};
+pub use problem::{build_problem, default_cost, placements, AfpOptions, AfpProblem, PrecedenceRule};
 pub use program::{ply_name, Course, Item, LineBreak, Ply, Program, Region, Segment, SwitchKey};
-pub use report::{totals, GroupCost, GroupRow, OrderRow, Report, Totals};
+pub use report::{cost_words, headline, totals, totals_table, GroupCost, GroupRow, OrderRow, Report, Totals};
 pub use reverse::{reversal_of, reverse_course, Irreversible, Reversed};
 pub use rewrite::{rewrite, Placement};
 pub use sequencer::{seed000_sets, sequence};

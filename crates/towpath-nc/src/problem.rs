@@ -81,7 +81,24 @@ impl Default for AfpOptions {
     }
 }
 
+/// The cost to optimize when none is chosen: cycle time ([`CostKind::Time`], all axes
+/// together, a reversed course paying for its heading turn) when every axis of the machine has
+/// a velocity limit, else Doherty et al.'s weighted axis distance ([`CostKind::Axis`]).
+pub fn default_cost(machine: &Machine) -> CostKind {
+    if machine.axes_without_velocity().is_empty() {
+        CostKind::Time
+    } else {
+        CostKind::Axis
+    }
+}
+
 impl AfpOptions {
+    /// The default options for a machine: as [`AfpOptions::default`], with the cost
+    /// [`default_cost`] chooses.
+    pub fn for_machine(machine: &Machine) -> AfpOptions {
+        AfpOptions { cost: default_cost(machine), ..AfpOptions::default() }
+    }
+
     /// The width to use: the options', else the dialect's (course width first).
     pub fn width_or(&self, dialect: &Dialect) -> Option<Width> {
         self.width.or(dialect.course_width.map(Width::Course)).or(dialect.tow_width.map(Width::Tow))

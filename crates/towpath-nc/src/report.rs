@@ -77,11 +77,15 @@ pub struct OrderRow {
     pub set: usize,
 }
 
-/// The savings report.
+/// The savings report. Cycle time leads: [`Report::cycle_time`] (when the machine has
+/// velocities), then the distances.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Report {
     /// The program's name.
     pub program: String,
+    /// Cycle time before and after (the machine's time model, seconds), when every axis of the
+    /// machine has a velocity limit.
+    pub cycle_time: Option<Totals>,
     /// The machine's name.
     pub machine: String,
     /// The cost model optimized.
@@ -120,6 +124,8 @@ pub struct Report {
     pub verified: bool,
     /// The input was returned unchanged because nothing cheaper was found.
     pub fell_back: bool,
+    /// Why the input was returned unchanged, if it was.
+    pub fallback: Option<crate::optimize::Fallback>,
     /// The course width used and where it came from.
     pub width: crate::width::WidthUsed,
     /// Where the width came from, in words for the user (`the dialect`; a caller that knows how
@@ -152,11 +158,13 @@ fn group(label: String, courses: &[usize], v: &Verification) -> GroupRow {
     GroupRow { label, courses: courses.len(), off_part }
 }
 
-/// Totals of a verification.
+/// Totals of a verification, cycle time first (when the machine has velocities), then the
+/// weighted axis distance and the tool-point distance.
 pub fn totals(v: &Verification) -> Vec<Totals> {
-    v.before
-        .iter()
-        .zip(&v.after)
+    let mut pairs: Vec<(&Motion, &Motion)> = v.before.iter().zip(&v.after).collect();
+    pairs.sort_by_key(|(b, _)| b.kind != CostKind::Time);
+    pairs
+        .into_iter()
         .map(|(b, a): (&Motion, &Motion)| Totals {
             kind: b.kind,
             unit: b.kind.unit(),
@@ -210,8 +218,10 @@ impl Report {
                 }
             })
             .collect();
+        let totals = totals(v);
         Report {
             program: name.to_string(),
+            cycle_time: totals.iter().find(|t| t.kind == CostKind::Time).cloned(),
             machine: machine.name.clone(),
             cost: opts.cost,
             bidirectional: opts.bidirectional,
@@ -227,7 +237,7 @@ impl Report {
                 .iter()
                 .map(|(c, why)| format!("{}: {why}", p.course_name(*c)))
                 .collect(),
-            totals: totals(v),
+            totals,
             per_ply,
             per_set,
             header_footer: v
@@ -246,6 +256,7 @@ impl Report {
             timings: o.timings.clone(),
             verified: true,
             fell_back: o.fell_back,
+            fallback: o.fallback,
             width: o.width.clone(),
             width_from: match o.width.source {
                 crate::width::WidthSource::Given => "the options given".into(),
@@ -275,39 +286,26 @@ impl Report {
         self.totals.iter().find(|t| t.kind == kind)
     }
 
-    /// A plain-text summary for a terminal.
+    /// A plain-text summary for a terminal: cycle time first, then distances.
     pub fn summary(&self) -> String {
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "{}: {} courses in {} plies ({} precedence sets), machine {}, cost {}, {}",
+            "{}: {} courses in {} {} ({} precedence {}), machine {}, optimized for {}, {}",
             self.program,
             self.courses,
             self.plies,
+            plural(self.plies, "ply", "plies"),
             self.precedence_sets,
+            plural(self.precedence_sets, "set", "sets"),
             self.machine,
-            self.cost,
+            cost_words(self.cost),
             if self.bidirectional { "bidirectional" } else { "unidirectional" }
         );
-        let _ = writeln!(
-            s,
-            "  {:<6} {:>14} {:>14} {:>8} {:>14} {:>14} {:>8}",
-            "cost", "off-part in", "off-part out", "saved", "total in", "total out", "saved"
-        );
-        for t in &self.totals {
-            let _ = writeln!(
-                s,
-                "  {:<6} {:>14.1} {:>14.1} {:>7.1}% {:>14.1} {:>14.1} {:>7.1}%   ({})",
-                t.kind.name(),
-                t.off_before,
-                t.off_after,
-                t.off_saved_percent,
-                t.total_before,
-                t.total_after,
-                t.total_saved_percent,
-                t.unit
-            );
+        for line in headline(&self.totals) {
+            let _ = writeln!(s, "  {line}");
         }
+        s.push_str(&totals_table(&self.totals));
         let _ = writeln!(
             s,
             "  {} courses reversed{}; verified; {:.2} s (solver {}: {:.2} s){}",
@@ -320,7 +318,10 @@ impl Report {
             self.timings.total,
             self.solver.solver,
             self.timings.solve,
-            if self.fell_back { "; no cheaper order found: the input is returned unchanged" } else { "" }
+            match &self.fallback {
+                Some(f) => format!("; {f}: the input is returned unchanged"),
+                None => String::new(),
+            }
         );
         let _ = writeln!(s, "  width: {}", self.width_line());
         s
@@ -335,22 +336,32 @@ impl Report {
              body{{font-family:system-ui,sans-serif;margin:2em;color:#222}}table{{border-collapse:collapse;margin:1em 0}}\
              td,th{{border:1px solid #ccc;padding:.25em .6em;text-align:right}}th{{background:#f3f3f3}}\
              td:first-child,th:first-child{{text-align:left}}.views{{display:flex;gap:1em;flex-wrap:wrap}}\
-             .views figure{{margin:0;border:1px solid #ccc}}figcaption{{padding:.3em;background:#f3f3f3}}</style></head><body>\n",
+             .views figure{{margin:0;border:1px solid #ccc}}.headline p{{margin:.2em 0;font-size:1.1em}}figcaption{{padding:.3em;background:#f3f3f3}}</style></head><body>\n",
             esc(&self.program)
         );
         let _ = writeln!(h, "<h1>towpath: {}</h1>", esc(&self.program));
+        // Cycle time leads, then distance.
+        h.push_str("<div class=\"headline\">");
+        for (i, line) in headline(&self.totals).iter().enumerate() {
+            let _ = write!(h, "<p>{}{}{}</p>", if i == 0 { "<b>" } else { "" }, esc(line), if i == 0 { "</b>" } else { "" });
+        }
+        h.push_str("</div>\n");
         let _ = writeln!(
             h,
-            "<p>{} courses in {} plies, {} seed-000 precedence sets; machine <b>{}</b>; optimized for <b>{}</b> cost, {}, precedence by {}; {} courses reversed. Verified against the input.{}</p>",
+            "<p>{} courses in {} {}, {} of Doherty et al.'s precedence sets; machine <b>{}</b>; optimized for <b>{}</b>, {}, precedence by {}; {} courses reversed. Verified against the input.{}</p>",
             self.courses,
             self.plies,
+            plural(self.plies, "ply", "plies"),
             self.precedence_sets,
             esc(&self.machine),
-            self.cost,
+            cost_words(self.cost),
             if self.bidirectional { "bidirectional" } else { "unidirectional" },
             self.precedence,
             self.reversed,
-            if self.fell_back { " No cheaper order was found: the input is returned unchanged." } else { "" }
+            match &self.fallback {
+                Some(f) => format!(" {}: the input is returned unchanged.", esc(&f.to_string())),
+                None => String::new(),
+            }
         );
         let _ = writeln!(h, "<p>Course width: {}.</p>", esc(&self.width_line()));
         for w in &self.warnings {
@@ -411,6 +422,93 @@ impl Report {
         h.push_str("</body></html>\n");
         h
     }
+}
+
+/// `one` or `many` by count.
+fn plural(n: usize, one: &'static str, many: &'static str) -> &'static str {
+    if n == 1 {
+        one
+    } else {
+        many
+    }
+}
+
+/// What a cost model optimizes, in words for the user.
+pub fn cost_words(kind: CostKind) -> &'static str {
+    match kind {
+        CostKind::Time => "cycle time",
+        CostKind::Axis => "Doherty et al.'s weighted axis distance",
+        CostKind::Tool => "tool-point distance",
+    }
+}
+
+/// The lines that lead every AFP summary: cycle time (off-part before -> after, % saved, total
+/// before -> after), then distance (Doherty et al.'s weighted axis distance and the tool
+/// point's path, when known). Without a time model, says so first.
+pub fn headline(totals: &[Totals]) -> Vec<String> {
+    let mut lines = Vec::new();
+    match totals.iter().find(|t| t.kind == CostKind::Time) {
+        Some(t) => lines.push(format!(
+            "cycle time: off-part {:.1} s -> {:.1} s ({} saved), total {:.1} s -> {:.1} s ({} saved)",
+            t.off_before,
+            t.off_after,
+            percent(t.off_saved_percent),
+            t.total_before,
+            t.total_after,
+            percent(t.total_saved_percent)
+        )),
+        None => lines.push(
+            "cycle time: unknown (the machine file gives no max_velocity for some axes); distances only".to_string(),
+        ),
+    }
+    let mut distance = Vec::new();
+    for t in totals.iter().filter(|t| t.kind != CostKind::Time) {
+        distance.push(format!(
+            "{} {:.0} -> {:.0} {} ({} saved)",
+            match t.kind {
+                CostKind::Axis => "weighted axis",
+                _ => "tool point",
+            },
+            t.off_before,
+            t.off_after,
+            t.unit,
+            percent(t.off_saved_percent)
+        ));
+    }
+    if !distance.is_empty() {
+        lines.push(format!("off-part distance: {}", distance.join("; ")));
+    }
+    lines
+}
+
+/// A saving in percent, one decimal.
+fn percent(p: f64) -> String {
+    format!("{p:.1} %")
+}
+
+/// The per-cost table of a summary (time first, as [`totals`] orders them).
+pub fn totals_table(totals: &[Totals]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "  {:<6} {:>14} {:>14} {:>8} {:>14} {:>14} {:>8}",
+        "cost", "off-part in", "off-part out", "saved", "total in", "total out", "saved"
+    );
+    for t in totals {
+        let _ = writeln!(
+            s,
+            "  {:<6} {:>14.1} {:>14.1} {:>7.1}% {:>14.1} {:>14.1} {:>7.1}%   ({})",
+            t.kind.name(),
+            t.off_before,
+            t.off_after,
+            t.off_saved_percent,
+            t.total_before,
+            t.total_after,
+            t.total_saved_percent,
+            t.unit
+        );
+    }
+    s
 }
 
 /// One warning for the courses kept forward because of codes the dialect does not describe (or
