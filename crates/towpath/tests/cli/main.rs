@@ -2,6 +2,7 @@
 //! `common`).
 
 mod afp;
+mod afp_hardening;
 mod common;
 mod convert;
 mod layup;
