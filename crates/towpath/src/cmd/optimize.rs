@@ -1,4 +1,5 @@
-//! `towpath optimize`: an AFP program in, the same part with less off-part motion out, verified.
+//! `towpath optimize`: an AFP program in, the same part in less cycle time (or less off-part
+//! motion) out, verified.
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -22,12 +23,14 @@ pub struct Args {
     /// Allow courses to be laid in reverse (heading turned 180°, tow restarts and cuts swapped).
     #[arg(long)]
     pub bidirectional: bool,
-    /// Cost of off-part moves: weighted axis distance (seed 000), motion time, or tool-point
-    /// distance.
-    #[arg(long, default_value = "axis", value_name = "axis|time|tool")]
-    pub cost: CostKind,
-    /// Precedence: a course after the courses of earlier plies it overlaps (courses), seed 000's
-    /// precedence sets (sets), or ply by ply (plies, needs no widths).
+    /// What to minimize: cycle time (time; the default when every axis of the machine file has
+    /// a max_velocity), Doherty et al.'s weighted axis distance (axis; the default otherwise),
+    /// or the tool point's distance (tool). Whatever is chosen, a program with a longer cycle
+    /// time than the input is never returned: the input order is kept instead.
+    #[arg(long, value_name = "time|axis|tool")]
+    pub cost: Option<CostKind>,
+    /// Precedence: a course after the courses of earlier plies it overlaps (courses), Doherty et
+    /// al.'s precedence sets (sets), or ply by ply (plies, needs no widths).
     #[arg(long, default_value = "courses", value_name = "courses|sets|plies")]
     pub precedence: PrecedenceRule,
     /// Keep the order of the courses within each ply.
@@ -84,7 +87,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let (machine, dialect, width) = args.machine.load()?;
     let text = read(&args.program)?;
     let afp = AfpOptions {
-        cost: args.cost,
+        cost: args.cost.unwrap_or_else(|| towpath_nc::default_cost(&machine)),
         bidirectional: args.bidirectional,
         precedence: args.precedence,
         keep_ply_order: args.keep_ply_order,

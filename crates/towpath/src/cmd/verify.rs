@@ -1,5 +1,5 @@
 //! `towpath verify`: checks an optimized AFP program against its original, independently of the
-//! optimizer, and prints the off-part motion before and after.
+//! optimizer, and prints the cycle time and the off-part motion before and after.
 
 use std::path::PathBuf;
 
@@ -20,7 +20,7 @@ pub struct Args {
     #[command(flatten)]
     pub machine: MachineArgs,
     /// The precedence the optimized program must keep: a course after the courses of earlier
-    /// plies it overlaps (courses, always checked), and also seed 000's precedence sets in order
+    /// plies it overlaps (courses, always checked), and also Doherty et al.'s precedence sets in order
     /// (sets) or every ply finished before the next starts (plies), as `optimize --precedence`.
     #[arg(long, default_value = "courses", value_name = "courses|sets|plies")]
     pub precedence: PrecedenceRule,
@@ -85,6 +85,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 "width": v.width,
                 "width_from": from,
                 "warnings": v.width.warning.iter().collect::<Vec<_>>(),
+                "cycle_time": t.iter().find(|x| x.kind == towpath_machine::CostKind::Time),
                 "totals": t,
             })
         );
@@ -97,34 +98,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         match (v.precedence_checked, opts.seed000_sets, opts.strict_plies) {
             (false, _, true) => "kept (ply by ply)",
             (false, ..) => "not needed (one ply)",
-            (true, true, _) => "kept (and seed 000's precedence sets in order)",
+            (true, true, _) => "kept (and Doherty et al.'s precedence sets in order)",
             (true, _, true) => "kept (and ply by ply)",
             (true, ..) => "kept",
         }
     );
-    outln!("  width: {width}");
-    outln!(
-        "  {:<6} {:>14} {:>14} {:>8} {:>14} {:>14} {:>8}",
-        "cost",
-        "off-part in",
-        "off-part out",
-        "saved",
-        "total in",
-        "total out",
-        "saved"
-    );
-    for x in &t {
-        outln!(
-            "  {:<6} {:>14.1} {:>14.1} {:>7.1}% {:>14.1} {:>14.1} {:>7.1}%   ({})",
-            x.kind.name(),
-            x.off_before,
-            x.off_after,
-            x.off_saved_percent,
-            x.total_before,
-            x.total_after,
-            x.total_saved_percent,
-            x.unit
-        );
+    // Cycle time first, then distance.
+    for line in towpath_nc::headline(&t) {
+        outln!("  {line}");
     }
+    outln!("  width: {width}");
+    crate::out!("{}", towpath_nc::totals_table(&t));
     Ok(())
 }

@@ -233,7 +233,7 @@ fn course_width_html_report_and_sets_precedence() {
     cmd.args(["--precedence", "sets"]);
     let (code, stdout, err) = run(&mut cmd);
     assert_eq!(code, 0, "{err}");
-    assert!(stdout.contains("seed 000's precedence sets in order"), "{stdout}");
+    assert!(stdout.contains("Doherty et al.'s precedence sets in order"), "{stdout}");
     // Both widths at once: refused by the argument parser.
     let mut cmd = towpath();
     cmd.arg("verify").arg(d.join("planar-0.nc")).arg(&out);

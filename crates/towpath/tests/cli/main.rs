@@ -5,6 +5,7 @@ mod afp;
 mod afp_hardening;
 mod common;
 mod convert;
+mod cycle_time;
 mod layup;
 mod machine;
 mod order;
