@@ -88,7 +88,7 @@ pub enum NcError {
     /// The sequencing engine refused the problem.
     #[error("sequencing: {0}")]
     Sequencing(String),
-    /// The chosen solver cannot sequence this program (one of the seed papers' solvers: the
+    /// The chosen solver cannot sequence this program (one of the published solvers towpath is built from: the
     /// message names it and what it cannot handle).
     #[error("{0}")]
     Solver(String),

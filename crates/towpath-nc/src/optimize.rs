@@ -30,10 +30,10 @@ pub struct OptimizeOptions {
     pub threads: usize,
     /// Called as the solver progresses.
     pub progress: Option<towpath_seq::ProgressFn>,
-    /// The solver: towpath's own (default) or one of the seed papers' (for comparison).
+    /// The solver: towpath's own (default) or one of the published solvers (for comparison).
     pub solver: SolverName,
-    /// Parameters of the seed papers' solvers. `doherty` without `sets` gets the program's
-    /// seed-000 precedence sets ([`crate::seed000_sets`]).
+    /// Parameters of the published solvers (docs/references.md). `doherty` without `sets` gets the program's
+    /// Doherty et al.'s precedence sets ([`crate::seed000_sets`]).
     pub baselines: BaselineParams,
 }
 
@@ -277,7 +277,7 @@ impl std::fmt::Display for Fallback {
 }
 
 /// Writes the program for a route found by any solver over `afp.problem` and verifies it
-/// against the original: the way to run another sequencing algorithm (seed 000's, for one) on
+/// against the original: the way to run another sequencing algorithm (Doherty et al.'s, for one) on
 /// the same parts. The steps are checked against the problem first.
 pub fn apply_steps(
     program: &Program,

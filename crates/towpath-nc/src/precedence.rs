@@ -6,7 +6,7 @@
 //!   laid over it, latest ply on top; a course that covers a whole cell hides the courses
 //!   below it (they overlap it, so they come before it already), and candidates are resolved
 //!   latest ply first, skipping those already implied.
-//! - The **seed-000 precedence network** ([`precedence_sets`]): consecutive plies that do not
+//! - The **precedence network of Doherty et al. (2022)** ([`precedence_sets`]): consecutive plies that do not
 //!   intersect are joined into one precedence set; each set comes after the one before.
 
 use std::collections::HashMap;
@@ -449,7 +449,7 @@ pub(crate) fn course_precedence_within(
     Ok(edges)
 }
 
-/// Seed 000's precedence network: consecutive plies joined while the next ply intersects none
+/// Doherty et al.'s precedence network: consecutive plies joined while the next ply intersects none
 /// of the set's courses. Returns the sets as lists of plies. Refused like
 /// [`course_precedence`] beyond [`MAX_VISITS`] grid entries.
 pub fn precedence_sets(fps: &Footprints, plies: &[Vec<usize>]) -> Result<Vec<Vec<usize>>, NcError> {
@@ -488,7 +488,7 @@ pub(crate) fn precedence_sets_within(
                 })
             });
         if budget.exceeded() {
-            return Err(budget.error("seed 000's precedence sets"));
+            return Err(budget.error("Doherty et al.'s precedence sets"));
         }
         if sets.is_empty() || intersects {
             sets.push(Vec::new());
@@ -651,7 +651,7 @@ mod tests {
         assert!(matches!(e, NcError::WorkLimit { limit: 10_000, .. }), "{e}");
         assert!(e.to_string().starts_with("course precedence: more than 10000 footprint comparisons"), "{e}");
         let e = precedence_sets_within(&fps, &plies, Limits { visits: 100, hits: MAX_CELL_HITS }).unwrap_err();
-        assert!(e.to_string().starts_with("seed 000's precedence sets: more than 100"), "{e}");
+        assert!(e.to_string().starts_with("Doherty et al.'s precedence sets: more than 100"), "{e}");
         let edges = course_precedence(&fps, &plies).unwrap();
         let r = closure(300, &edges);
         let want = relation(&fps, &|c| c / 150);

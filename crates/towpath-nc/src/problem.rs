@@ -26,7 +26,7 @@ pub enum PrecedenceRule {
     /// A course after every course of an earlier ply it overlaps (default).
     #[default]
     Courses,
-    /// Seed 000's precedence sets: each set after the one before.
+    /// Doherty et al.'s precedence sets: each set after the one before.
     Sets,
     /// Every ply after the one before.
     Plies,
@@ -110,7 +110,7 @@ impl AfpOptions {
 pub struct AfpProblem {
     /// The problem: task `c` is course `c`; mode 0 forward, mode 1 (if any) reverse.
     pub problem: Problem<MachineCost>,
-    /// Seed 000's precedence sets, in order, as lists of courses (each ply alone when there are
+    /// Doherty et al.'s precedence sets, in order, as lists of courses (each ply alone when there are
     /// no footprints).
     pub sets: Vec<Vec<usize>>,
     /// The plies of each set.

@@ -73,7 +73,7 @@ pub struct OrderRow {
     pub line: usize,
     /// Laid in reverse.
     pub reversed: bool,
-    /// Its seed-000 precedence set, from 1.
+    /// Its Doherty et al.'s precedence set, from 1.
     pub set: usize,
 }
 
@@ -98,7 +98,7 @@ pub struct Report {
     pub courses: usize,
     /// Plies.
     pub plies: usize,
-    /// Seed-000 precedence sets.
+    /// Doherty et al.'s precedence sets.
     pub precedence_sets: usize,
     /// Precedence edges given to the solver.
     pub precedence_edges: usize,
@@ -110,7 +110,7 @@ pub struct Report {
     pub totals: Vec<Totals>,
     /// Per ply.
     pub per_ply: Vec<GroupRow>,
-    /// Per seed-000 precedence set.
+    /// Per Doherty et al.'s precedence set.
     pub per_set: Vec<GroupRow>,
     /// Off-part motion of the header and footer (per cost model: before, after).
     pub header_footer: Vec<GroupCost>,

@@ -32,7 +32,7 @@ pub struct VerifyOptions {
     pub strict_plies: bool,
     /// Also require the courses of each ply in their original order.
     pub keep_ply_order: bool,
-    /// Also require seed 000's precedence sets in order: every course of a set laid before any
+    /// Also require Doherty et al.'s precedence sets in order: every course of a set laid before any
     /// course of the next (the verifier finds the sets on its own, from the footprints).
     pub seed000_sets: bool,
 }
@@ -863,7 +863,7 @@ fn check_precedence(orig: &Program, fps: &Footprints, order: &[Placement]) -> Re
     Ok(())
 }
 
-/// Seed 000's precedence sets, found here on their own: the plies in program order, each
+/// Doherty et al.'s precedence sets, found here on their own: the plies in program order, each
 /// joining the current set unless one of its courses overlaps a course already in it, else
 /// starting the next set. Returns the set of each course (sets numbered from 0).
 fn sets_of_courses(plies: &[Vec<usize>], fps: &Footprints) -> Result<Vec<usize>, VerifyError> {
@@ -881,7 +881,7 @@ fn sets_of_courses(plies: &[Vec<usize>], fps: &Footprints) -> Result<Vec<usize>,
                     let Some(v) = grid.get(&key) else { continue };
                     visits += v.len() as u64;
                     if visits > MAX_GRID_VISITS {
-                        return Err(too_dense("finding seed 000's precedence sets"));
+                        return Err(too_dense("finding Doherty et al.'s precedence sets"));
                     }
                     if v.iter()
                         .any(|&(x, qx)| crate::precedence::quads_overlap(&fps.frame, q, &fps.courses[x].quads[qx]))
@@ -908,7 +908,7 @@ fn sets_of_courses(plies: &[Vec<usize>], fps: &Footprints) -> Result<Vec<usize>,
     Ok(set_of)
 }
 
-/// Every course of a seed-000 precedence set must be laid before any course of the next.
+/// Every course of a Doherty et al.'s precedence set must be laid before any course of the next.
 fn check_sets(orig: &Program, fps: &Footprints, order: &[Placement]) -> Result<(), VerifyError> {
     let plies: Vec<Vec<usize>> = orig.plies.iter().map(|p| p.courses.clone()).collect();
     let set_of = sets_of_courses(&plies, fps)?;
@@ -917,7 +917,7 @@ fn check_sets(orig: &Program, fps: &Footprints, order: &[Placement]) -> Result<(
         if let Some(l) = latest {
             if set_of[p.course] < set_of[l] {
                 return Err(VerifyError::Order(format!(
-                    "{} (seed-000 precedence set {}) is laid after {} (set {}): each set must be finished before the next starts",
+                    "{} (Doherty et al.'s precedence set {}) is laid after {} (set {}): each set must be finished before the next starts",
                     orig.course_name(p.course),
                     set_of[p.course] + 1,
                     orig.course_name(l),
@@ -1003,7 +1003,7 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
-        /// The verifier's own seed-000 sets are the optimizer's (`precedence_sets`), found by
+        /// The verifier's own Doherty et al.'s precedence sets are the optimizer's (`precedence_sets`), found by
         /// other code.
         #[test]
         fn verifier_sets_agree_with_the_optimizer_s(

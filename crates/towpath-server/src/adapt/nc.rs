@@ -584,7 +584,7 @@ pub fn optimize(
         per_ply,
         verified: report.verified,
         verdict,
-        fell_back,
+        fell_back: o.fell_back,
         solver_cost: (o.solver.initial_cost, o.solver.cost),
     })
 }

@@ -153,7 +153,7 @@ fn bad_input_names_file_and_line() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-/// `towpath optimize --solver NAME`: the seed papers' solvers sequence the same program, their
+/// `towpath optimize --solver NAME`: the published solvers (docs/references.md) sequence the same program, their
 /// answers are written and verified like towpath's, and the report says which solver ran.
 #[test]
 fn optimize_with_each_solver() {
@@ -193,7 +193,7 @@ fn optimize_with_each_solver() {
         assert_eq!(code, 0, "{solver}: {err}");
         assert!(stdout.starts_with("verified: 30 courses"), "{solver}: {stdout}");
     }
-    // Seed 000's solver lays each precedence set freely: it cannot keep the ply order.
+    // Doherty et al.'s solver lays each precedence set freely: it cannot keep the ply order.
     let (code, _, err) = optimize("doherty", &["--keep-ply-order"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("planar-0.nc") && err.contains("doherty") && err.contains("--keep-ply-order"), "{err}");
