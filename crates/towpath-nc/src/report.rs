@@ -336,7 +336,7 @@ impl Report {
              body{{font-family:system-ui,sans-serif;margin:2em;color:#222}}table{{border-collapse:collapse;margin:1em 0}}\
              td,th{{border:1px solid #ccc;padding:.25em .6em;text-align:right}}th{{background:#f3f3f3}}\
              td:first-child,th:first-child{{text-align:left}}.views{{display:flex;gap:1em;flex-wrap:wrap}}\
-             .views figure{{margin:0;border:1px solid #ccc}}.headline p{{margin:.2em 0;font-size:1.1em}}figcaption{{padding:.3em;background:#f3f3f3}}</style></head><body>\n",
+             .views figure{{margin:0;border:1px solid #ccc}}.headline p{{margin:.2em 0;font-size:1.1em}}.legend span{{margin-right:1em;white-space:nowrap}}.legend i{{display:inline-block;width:1.4em;height:.5em;margin-right:.3em;vertical-align:middle}}figcaption{{padding:.3em;background:#f3f3f3}}</style></head><body>\n",
             esc(&self.program)
         );
         let _ = writeln!(h, "<h1>towpath: {}</h1>", esc(&self.program));
@@ -533,10 +533,15 @@ fn esc(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
-/// Polylines of a program in the frame: (on-part?, points).
-fn polylines(p: &Program, machine: &Machine, frame: &Frame) -> Vec<(bool, Vec<[f64; 2]>)> {
+/// Colours of the plies in the plan view, in turn.
+const PLY_COLOURS: [&str; 8] = ["#1b9e77", "#7570b3", "#e6ab02", "#66a61e", "#e7298a", "#a6761d", "#1f78b4", "#666"];
+
+/// Polylines of a program in the frame: (the ply of an on-part run, or `None` off-part;
+/// points).
+fn polylines(p: &Program, machine: &Machine, frame: &Frame) -> Vec<(Option<usize>, Vec<[f64; 2]>)> {
     let Some(kin) = machine.kinematics() else { return Vec::new() };
-    let mut out: Vec<(bool, Vec<[f64; 2]>)> = Vec::new();
+    let regions = p.regions();
+    let mut out: Vec<(Option<usize>, Vec<[f64; 2]>)> = Vec::new();
     for s in &p.segments {
         let a = frame.map(kin.part_point(p.point(s.from)));
         let mut b = frame.map(kin.part_point(p.point(s.to)));
@@ -544,16 +549,28 @@ fn polylines(p: &Program, machine: &Machine, frame: &Frame) -> Vec<(bool, Vec<[f
         if (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-9 {
             continue;
         }
+        let ply = match regions.get(s.line as usize) {
+            Some(crate::program::Region::OnPart(k)) if s.on_part => p.courses.get(*k).map(|c| c.ply).or(Some(0)),
+            _ if s.on_part => Some(0),
+            _ => None,
+        };
         match out.last_mut() {
-            Some((on, pts))
-                if *on == s.on_part && pts.last().is_some_and(|l| (l[0] - a[0]).abs() + (l[1] - a[1]).abs() < 1e-9) =>
+            Some((q, pts))
+                if *q == ply && pts.last().is_some_and(|l| (l[0] - a[0]).abs() + (l[1] - a[1]).abs() < 1e-9) =>
             {
                 pts.push(b)
             }
-            _ => out.push((s.on_part, vec![a, b])),
+            _ => out.push((ply, vec![a, b])),
         }
     }
     out
+}
+
+/// A round length for a scale bar about a fifth of `span`: 1, 2 or 5 times a power of ten.
+fn scale_length(span: f64) -> f64 {
+    let target = (span / 5.0).max(1e-9);
+    let base = 10f64.powf(target.log10().floor());
+    [5.0, 2.0, 1.0].into_iter().map(|k| k * base).find(|&l| l <= target).unwrap_or(base)
 }
 
 fn plan_views(o: &Optimized, optimized: &Program, machine: &Machine) -> Option<String> {
@@ -578,28 +595,59 @@ fn plan_views(o: &Optimized, optimized: &Program, machine: &Machine) -> Option<S
         return None;
     }
     let (w, hgt) = ((hi[0] - lo[0]).max(1.0), (hi[1] - lo[1]).max(1.0));
-    let pad = 0.03 * w.max(hgt);
+    let pad = 0.08 * w.max(hgt);
     let stroke = 0.002 * w.max(hgt);
-    let view = |lines: &[(bool, Vec<[f64; 2]>)], off_color: &str, caption: &str, value: String| -> String {
+    let bar = scale_length(w);
+    let view = |id: &str, lines: &[(Option<usize>, Vec<[f64; 2]>)], off_color: &str, caption: &str, value: String| {
         let mut s = String::new();
         let _ = write!(
             s,
-            "<figure><svg xmlns=\"http://www.w3.org/2000/svg\" width=\"560\" viewBox=\"{} {} {} {}\" style=\"background:#fff\"><g transform=\"scale(1,-1)\">",
+            "<figure><svg xmlns=\"http://www.w3.org/2000/svg\" width=\"560\" viewBox=\"{} {} {} {}\" style=\"background:#fff\">\
+             <defs><marker id=\"arrow-{id}\" viewBox=\"0 0 10 10\" refX=\"5\" refY=\"5\" markerWidth=\"3\" markerHeight=\"3\" \
+             orient=\"auto\"><path d=\"M0,0 L10,5 L0,10 z\" fill=\"#222\"/></marker></defs><g transform=\"scale(1,-1)\">",
             lo[0] - pad,
             -hi[1] - pad,
             w + 2.0 * pad,
             hgt + 2.0 * pad
         );
-        for (on, pts) in lines {
+        for (ply, pts) in lines {
             let d: Vec<String> = pts.iter().map(|p| format!("{:.1},{:.1}", p[0], p[1])).collect();
-            let (color, width) = if *on { ("#999", 4.0 * stroke) } else { (off_color, stroke) };
+            let (color, width, arrow) = match ply {
+                Some(k) => (PLY_COLOURS[k % PLY_COLOURS.len()], 4.0 * stroke, format!(" marker-end=\"url(#arrow-{id})\"")),
+                None => (off_color, stroke, String::new()),
+            };
             let _ = write!(
                 s,
-                "<polyline fill=\"none\" stroke=\"{color}\" stroke-width=\"{width:.2}\" stroke-linejoin=\"round\" points=\"{}\"/>",
+                "<polyline fill=\"none\" stroke=\"{color}\" stroke-width=\"{width:.2}\" stroke-linejoin=\"round\"{arrow} points=\"{}\"/>",
                 d.join(" ")
             );
         }
-        let _ = write!(s, "</g></svg><figcaption>{caption}: {value}</figcaption></figure>");
+        // Where the program starts: its first move's start.
+        if let Some(p) = lines.first().and_then(|(_, pts)| pts.first()) {
+            let _ = write!(
+                s,
+                "<circle class=\"start\" cx=\"{:.1}\" cy=\"{:.1}\" r=\"{:.2}\" fill=\"#0a0\" stroke=\"#fff\" stroke-width=\"{:.2}\"/>",
+                p[0],
+                p[1],
+                6.0 * stroke,
+                stroke
+            );
+        }
+        s.push_str("</g>");
+        // Scale bar, below the drawing (unflipped coordinates).
+        let (x0, y0) = (lo[0], -lo[1] + 0.55 * pad);
+        let _ = write!(
+            s,
+            "<g class=\"scale\"><line x1=\"{x0:.1}\" y1=\"{y0:.1}\" x2=\"{:.1}\" y2=\"{y0:.1}\" stroke=\"#000\" stroke-width=\"{:.2}\"/>\
+             <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"{:.1}\" font-family=\"sans-serif\">{} mm</text></g>",
+            x0 + bar,
+            2.0 * stroke,
+            x0 + bar + 0.1 * pad,
+            y0 + 0.15 * pad,
+            0.4 * pad,
+            bar
+        );
+        let _ = write!(s, "</svg><figcaption>{caption}: {value}</figcaption></figure>");
         s
     };
     let off = |m: &[Motion]| {
@@ -608,9 +656,43 @@ fn plan_views(o: &Optimized, optimized: &Program, machine: &Machine) -> Option<S
             .map_or(String::new(), |x| format!("off-part tool path {:.0} mm", x.off_part()))
     };
     let label = if matches!(frame, Frame::Cylinder { .. }) { " (cylinder unrolled)" } else { "" };
+    let mut legend = String::from("<p class=\"legend\">");
+    for (k, ply) in o.program.plies.iter().enumerate() {
+        let _ = write!(
+            legend,
+            "<span><i style=\"background:{}\"></i>ply {}</span> ",
+            PLY_COLOURS[k % PLY_COLOURS.len()],
+            esc(&ply_name(ply))
+        );
+    }
+    let _ = write!(
+        legend,
+        "<span><i style=\"background:#d22;height:2px\"></i>off-part before</span> \
+         <span><i style=\"background:#14c;height:2px\"></i>off-part after</span> \
+         <span><b style=\"color:#0a0\">●</b> start</span> <span>▶ course direction</span></p>"
+    );
     Some(format!(
-        "<div class=\"views\">{}{}</div><p>Grey: laid courses; red/blue: off-part motion{label}.</p>",
-        view(&before, "#d22", "before", off(&o.verification.before)),
-        view(&after, "#14c", "after", off(&o.verification.after))
+        "<div class=\"views\">{}{}</div>{legend}<p>Laid courses coloured by ply, an arrow at each course's end; \
+         thin lines: off-part motion{label}; the bar gives the scale in mm.</p>",
+        view("before", &before, "#d22", "before", off(&o.verification.before)),
+        view("after", &after, "#14c", "after", off(&o.verification.after))
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::scale_length;
+
+    /// The scale bar is 1, 2 or 5 times a power of ten, at most a fifth of the span and more
+    /// than half of that fifth's largest such length.
+    #[test]
+    fn scale_bars_are_round_and_about_a_fifth() {
+        for (span, want) in [(1000.0, 200.0), (1200.0, 200.0), (2600.0, 500.0), (49.0, 5.0), (5.0, 1.0), (0.9, 0.1)] {
+            assert!((scale_length(span) - want).abs() < 1e-9 * want, "{span}: {}", scale_length(span));
+        }
+        for span in [3.0, 17.0, 480.0, 7777.0] {
+            let l = scale_length(span);
+            assert!(l <= span / 5.0 + 1e-9 && l > span / 5.0 / 2.5, "{span}: {l}");
+        }
+    }
 }

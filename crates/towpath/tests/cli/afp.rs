@@ -227,6 +227,15 @@ fn course_width_html_report_and_sets_precedence() {
         "{}",
         &page[..200.min(page.len())]
     );
+    // Plan view: plies coloured with a legend, an arrow per laid course, a start marker and a
+    // scale bar in each of the two views.
+    assert_eq!(page.matches("class=\"start\"").count(), 2, "start markers");
+    assert_eq!(page.matches("<g class=\"scale\">").count(), 2, "scale bars");
+    assert!(page.matches("marker-end=").count() >= 2 * 30, "an arrow per course in each view");
+    for ply in 1..=4 {
+        assert!(page.contains(&format!("</i>ply {ply}</span>")), "legend for ply {ply}");
+    }
+    assert!(page.find("cycle time: off-part").unwrap() < page.find("<h2>Totals").unwrap(), "time leads");
     let mut cmd = towpath();
     cmd.arg("verify").arg(d.join("planar-0.nc")).arg(&out);
     base(&mut cmd);
