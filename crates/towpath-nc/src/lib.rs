@@ -34,7 +34,10 @@ pub use footprint::{
 };
 pub use interp::{Event, Interp, Marker, Modal};
 pub use lex::{lex, LexIssue, Lexed, NumText, Word};
-pub use optimize::{apply_steps, auto_time_limit, fallback_reason, optimize, Fallback, OptimizeOptions, Optimized, SolverSummary, Timings};
+pub use optimize::{
+    apply_steps, auto_time_limit, fallback_reason, optimize, Fallback, OptimizeOptions, Optimized, SolverSummary,
+    Timings,
+};
 pub use parse::parse;
 pub use precedence::{course_precedence, precedence_sets, MAX_VISITS};
 pub use problem::{build_problem, default_cost, placements, AfpOptions, AfpProblem, PrecedenceRule};

@@ -232,8 +232,11 @@ pub fn fallback_reason(v: &Verification, cost: CostKind) -> Option<Fallback> {
         }
     }
     let (before, after) = v.motion(cost)?;
-    worse(before.off_part(), after.off_part())
-        .then(|| Fallback::Cost { kind: cost, before: before.off_part(), after: after.off_part() })
+    worse(before.off_part(), after.off_part()).then(|| Fallback::Cost {
+        kind: cost,
+        before: before.off_part(),
+        after: after.off_part(),
+    })
 }
 
 /// Why [`optimize`] returned the input unchanged.

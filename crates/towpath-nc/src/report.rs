@@ -343,7 +343,13 @@ impl Report {
         // Cycle time leads, then distance.
         h.push_str("<div class=\"headline\">");
         for (i, line) in headline(&self.totals).iter().enumerate() {
-            let _ = write!(h, "<p>{}{}{}</p>", if i == 0 { "<b>" } else { "" }, esc(line), if i == 0 { "</b>" } else { "" });
+            let _ = write!(
+                h,
+                "<p>{}{}{}</p>",
+                if i == 0 { "<b>" } else { "" },
+                esc(line),
+                if i == 0 { "</b>" } else { "" }
+            );
         }
         h.push_str("</div>\n");
         let _ = writeln!(
@@ -613,7 +619,9 @@ fn plan_views(o: &Optimized, optimized: &Program, machine: &Machine) -> Option<S
         for (ply, pts) in lines {
             let d: Vec<String> = pts.iter().map(|p| format!("{:.1},{:.1}", p[0], p[1])).collect();
             let (color, width, arrow) = match ply {
-                Some(k) => (PLY_COLOURS[k % PLY_COLOURS.len()], 4.0 * stroke, format!(" marker-end=\"url(#arrow-{id})\"")),
+                Some(k) => {
+                    (PLY_COLOURS[k % PLY_COLOURS.len()], 4.0 * stroke, format!(" marker-end=\"url(#arrow-{id})\""))
+                }
                 None => (off_color, stroke, String::new()),
             };
             let _ = write!(

@@ -35,7 +35,11 @@ fn demo_parts_default_run_is_never_slower() {
             part.name, o.fallback
         );
         assert!(after <= before * (1.0 + 1e-9), "{}: cycle time {before} -> {after}", part.name);
-        assert!(off_after <= off_before * (1.0 + 1e-9) + 1e-9, "{}: off-part time {off_before} -> {off_after}", part.name);
+        assert!(
+            off_after <= off_before * (1.0 + 1e-9) + 1e-9,
+            "{}: off-part time {off_before} -> {off_after}",
+            part.name
+        );
     }
 }
 

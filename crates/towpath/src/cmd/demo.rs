@@ -217,8 +217,7 @@ fn invocation() -> String {
         return "towpath".into();
     };
     let on_path = std::env::var_os("PATH").is_some_and(|paths| {
-        std::env::split_paths(&paths)
-            .any(|d| d.join("towpath").canonicalize().is_ok_and(|found| found == exe))
+        std::env::split_paths(&paths).any(|d| d.join("towpath").canonicalize().is_ok_and(|found| found == exe))
     });
     if on_path {
         return "towpath".into();
@@ -263,4 +262,3 @@ fn shell_quote(s: &str) -> String {
         format!("'{}'", s.replace('\'', "'\\''"))
     }
 }
-

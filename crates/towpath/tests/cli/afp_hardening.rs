@@ -101,7 +101,10 @@ fn rapids_in_contact_and_cr_line_ends() {
     std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
     let (code, _, err) = optimize(&d, &bad, "gantry-afp.toml", &["--dialect", &dialect(&d)], &d.join("o.nc"));
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains(&format!("rapid.nc: line {}: a rapid move (G0) while the roller is in contact", mv + 1)), "{err}");
+    assert!(
+        err.contains(&format!("rapid.nc: line {}: a rapid move (G0) while the roller is in contact", mv + 1)),
+        "{err}"
+    );
     let (code, _, err) = verify(&d, &d.join("planar-0.nc"), &bad, "gantry-afp.toml", &["--dialect", &dialect(&d)]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains(&format!("rapid.nc: line {}", mv + 1)), "{err}");
@@ -109,7 +112,8 @@ fn rapids_in_contact_and_cr_line_ends() {
     let cr = d.join("cr.nc");
     std::fs::write(&cr, text.replace('\n', "\r")).unwrap();
     let out = d.join("cr.opt.nc");
-    let (code, stdout, err) = optimize(&d, &cr, "gantry-afp.toml", &["--dialect", &dialect(&d), "--bidirectional"], &out);
+    let (code, stdout, err) =
+        optimize(&d, &cr, "gantry-afp.toml", &["--dialect", &dialect(&d), "--bidirectional"], &out);
     assert_eq!(code, 0, "{err}");
     assert!(stdout.contains("30 courses in 4 plies"), "{stdout}");
     let written = std::fs::read(&out).unwrap();

@@ -123,10 +123,13 @@ fn demo_follow_up_commands_work_as_pasted() {
             }
             (_, p) => p.unwrap_or_default(),
         };
-        let (code, out, err) = run(towpath()
-            .current_dir(&here)
-            .env("PATH", &path)
-            .args(["demo", "--iterations", "20", "--dir", "my demo"]));
+        let (code, out, err) = run(towpath().current_dir(&here).env("PATH", &path).args([
+            "demo",
+            "--iterations",
+            "20",
+            "--dir",
+            "my demo",
+        ]));
         assert_eq!(code, 0, "{err}");
         let tail = &out[out.find("To run one part yourself:").unwrap()..];
         let script: String = tail.lines().skip(1).collect::<Vec<_>>().join("\n");
@@ -137,10 +140,8 @@ fn demo_follow_up_commands_work_as_pasted() {
             assert!(first.starts_with("../") || first.starts_with('/'), "{script}");
         }
         assert!(script.contains("'my demo/planar-45.nc'"), "a folder with a space is quoted: {script}");
-        let (code, sh_out, sh_err) = run(std::process::Command::new("sh")
-            .current_dir(&here)
-            .env("PATH", &path)
-            .args(["-e", "-c", &script]));
+        let (code, sh_out, sh_err) =
+            run(std::process::Command::new("sh").current_dir(&here).env("PATH", &path).args(["-e", "-c", &script]));
         assert_eq!(code, 0, "{script}\n{sh_out}\n{sh_err}");
         assert!(sh_out.contains("verified: 49 courses"), "{sh_out}");
         assert!(here.join("my demo/planar-45.mine.nc").exists() && here.join("my demo/planar-45.mine.html").exists());
