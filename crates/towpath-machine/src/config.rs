@@ -308,7 +308,7 @@ impl Machine {
                     ));
                 }
                 let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                if !(n > 1e-9) {
+                if n <= 1e-9 {
                     return Err(invalid(key("direction"), "the mandrel direction must be a non-zero vector"));
                 }
             }

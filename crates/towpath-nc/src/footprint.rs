@@ -255,7 +255,7 @@ pub fn frame_for(
         for p in [s.from, s.to] {
             let r = radius_of(p);
             let min = (w / std::f64::consts::TAU).max(1e-3);
-            if !(r >= min) {
+            if r.is_nan() || r < min {
                 return Err(NcError::MandrelAxis {
                     line: s.line as usize + 1,
                     radius: r,

@@ -328,12 +328,8 @@ fn stray_cr(line: &str, dialect: &Dialect) -> bool {
             '(' if dialect.comment_parens && !in_parens => in_parens = true,
             ')' if in_parens => in_parens = false,
             ';' if dialect.comment_semicolon && !in_parens => return false,
-            '\r' if !in_parens && i >= first => {
-                // Only trailing whitespace after it is harmless.
-                if !line[i..].trim().is_empty() {
-                    return true;
-                }
-            }
+            // Only trailing whitespace after it is harmless.
+            '\r' if !in_parens && i >= first && !line[i..].trim().is_empty() => return true,
             _ => {}
         }
     }

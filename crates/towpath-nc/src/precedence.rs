@@ -363,10 +363,8 @@ pub(crate) fn course_precedence_within(
                         for h in &sc.hits {
                             let Some(stack) = cells.get(h.key) else { continue };
                             spent += stack.len() as u64 + 1;
-                            if spent >= 1 << 16 {
-                                if !budget.spend(std::mem::take(&mut spent)) {
-                                    return (c, Vec::new(), Bits::default());
-                                }
+                            if spent >= 1 << 16 && !budget.spend(std::mem::take(&mut spent)) {
+                                return (c, Vec::new(), Bits::default());
                             }
                             let mut stop: Option<u32> = None;
                             for e in stack.iter().rev() {

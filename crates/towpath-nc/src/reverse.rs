@@ -512,9 +512,16 @@ fn unknown_words(lexed: &Lexed, line: &str, codes: &crate::dialect::Codes, it: &
     let known = |w: &crate::lex::Word| {
         let (l, v) = (w.letter, w.value);
         (l == 'G'
-            && (codes.rapid.iter().chain(&codes.feed).chain(&codes.arc_cw).chain(&codes.arc_ccw).chain(&codes.planes))
-                .any(|c| c.matches(l, v)))
-            || (l == 'G' && (codes.absolute.matches(l, v) || codes.incremental.matches(l, v)))
+            && ((codes
+                .rapid
+                .iter()
+                .chain(&codes.feed)
+                .chain(&codes.arc_cw)
+                .chain(&codes.arc_ccw)
+                .chain(&codes.planes))
+            .any(|c| c.matches(l, v))
+                || codes.absolute.matches(l, v)
+                || codes.incremental.matches(l, v)))
             || (l == 'M'
                 && (codes.restart.matches(l, v)
                     || codes.cut.matches(l, v)

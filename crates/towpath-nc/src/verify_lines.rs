@@ -150,7 +150,7 @@ impl<'a> Reader<'a> {
             return Kind::Empty;
         }
         if event {
-            return if !(modal || set_pos || non_motion || point || switch.is_some()) && !axis {
+            return if !(modal || set_pos || non_motion || point || switch.is_some() || axis) {
                 Kind::Event
             } else if axis && !set_pos && !non_motion && !point && switch.is_none() {
                 // Tow or contact codes written on a move.
@@ -545,9 +545,9 @@ pub(crate) fn account(
     // Ply comments of plies with courses may move and repeat; every one must be there (those
     // between courses: one inside a span, where a long retract block reaches, stays with it).
     let between = |j: usize| {
-        orig.courses.iter().any(|c| {
-            [&c.pre_before, &c.pre_after, &c.post].iter().any(|items| items.iter().any(|i| *i == Item::Line(j)))
-        })
+        orig.courses
+            .iter()
+            .any(|c| [&c.pre_before, &c.pre_after, &c.post].iter().any(|items| items.contains(&Item::Line(j))))
     };
     let mut marker_lines: Vec<usize> =
         orig.plies.iter().filter(|p| !p.courses.is_empty()).filter_map(|p| p.line).filter(|&j| between(j)).collect();
