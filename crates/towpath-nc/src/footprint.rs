@@ -277,7 +277,7 @@ pub fn frame_for(
 
 /// Builds the footprints of every course. Needs the machine's kinematics and a width; refuses a
 /// width narrower than [`MIN_WIDTH`] or wider than [`MAX_WIDTH_PER_SPAN`] times the laid part,
-/// and laid points on or near a mandrel's axis (see [`frame_for`]).
+/// and laid points on or near a mandrel's axis (closer than the course width / 2π, where the unrolled course would wrap the whole mandrel).
 pub fn footprints(program: &Program, machine: &Machine, width: Width) -> Result<Footprints, NcError> {
     footprints_within(program, machine, width, MAX_PIECES)
 }
