@@ -150,9 +150,13 @@ pub enum MachineError {
         /// What is wrong.
         message: String,
     },
-    /// A value is out of range or inconsistent; `key` names it (`axis[2].weight`).
-    #[error("{key}: {message}")]
+    /// A value is out of range or inconsistent; `key` names it (`axis[2].weight`), `line` the
+    /// line of the file that sets it (or the line of its table when the value is a default;
+    /// 0 for a machine not read from a file).
+    #[error("{}{key}: {message}", at_line(*line))]
     Invalid {
+        /// 1-based line in the file, 0 if unknown.
+        line: usize,
         /// The key, as a path.
         key: String,
         /// What is wrong.
@@ -160,9 +164,31 @@ pub enum MachineError {
     },
 }
 
-fn invalid(key: impl Into<String>, message: impl Into<String>) -> MachineError {
-    MachineError::Invalid { key: key.into(), message: message.into() }
+fn at_line(line: usize) -> String {
+    if line > 0 {
+        format!("line {line}: ")
+    } else {
+        String::new()
+    }
 }
+
+fn invalid(key: impl Into<String>, message: impl Into<String>) -> MachineError {
+    MachineError::Invalid { line: 0, key: key.into(), message: message.into() }
+}
+
+/// Largest magnitude of a position in a machine file (axis `home`, `min`, `max`, the mandrel's
+/// `origin`, `tool_offset`, DH lengths), in mm or degrees: the range programs may use.
+pub const MAX_AXIS_VALUE: f64 = 1e7;
+/// Largest axis `weight`.
+pub const MAX_WEIGHT: f64 = 1e6;
+/// Range of `max_velocity`, mm/s or deg/s.
+pub const VELOCITY_RANGE: (f64, f64) = (1e-3, 1e7);
+/// Range of `max_acceleration`, mm/s² or deg/s².
+pub const ACCELERATION_RANGE: (f64, f64) = (1e-3, 1e9);
+/// Largest magnitude of a DH angle (`alpha`, `theta`), degrees.
+pub const MAX_DH_ANGLE: f64 = 1e6;
+/// Most axes, and most DH joints, a machine may have.
+pub const MAX_AXES: usize = 64;
 
 impl Machine {
     /// A machine with the given axes and no kinematics.
@@ -172,13 +198,19 @@ impl Machine {
         Ok(m)
     }
 
-    /// Reads a machine from TOML text and validates it.
+    /// Reads a machine from TOML text and validates it; a refused value names the line that
+    /// sets it.
     pub fn from_toml_str(text: &str) -> Result<Self, MachineError> {
         let m: Machine = toml::from_str(text).map_err(|e| {
             let line = e.span().map_or(0, |s| text[..s.start.min(text.len())].matches('\n').count() + 1);
             MachineError::Syntax { line, message: e.message().to_string() }
         })?;
-        m.validate()?;
+        m.validate().map_err(|e| match e {
+            MachineError::Invalid { key, message, .. } => {
+                MachineError::Invalid { line: crate::locate::line_of(text, &key), key, message }
+            }
+            e => e,
+        })?;
         Ok(m)
     }
 
@@ -192,6 +224,12 @@ impl Machine {
     pub fn validate(&self) -> Result<(), MachineError> {
         if self.axes.is_empty() {
             return Err(invalid("axis", "the machine has no axes"));
+        }
+        if self.axes.len() > MAX_AXES {
+            return Err(invalid("axis", format!("{} axes: a machine has at most {MAX_AXES}", self.axes.len())));
+        }
+        if self.dh.len() > MAX_AXES {
+            return Err(invalid("dh", format!("{} joints: a DH chain has at most {MAX_AXES}", self.dh.len())));
         }
         let mut headings = 0;
         let mut mandrels = 0;
@@ -207,23 +245,34 @@ impl Machine {
                 return Err(invalid(key("label"), format!("axis {:?} is defined twice (also axis[{j}])", a.label)));
             }
             if !(a.weight.is_finite() && a.weight >= 0.0) {
-                return Err(invalid(key("weight"), format!("{} is not a finite weight ≥ 0", a.weight)));
+                return Err(invalid(key("weight"), format!("{} is not a finite weight ≥ 0", num(a.weight))));
             }
-            for (k, v) in [("max_velocity", a.max_velocity), ("max_acceleration", a.max_acceleration)] {
+            if a.weight > MAX_WEIGHT {
+                return Err(invalid(
+                    key("weight"),
+                    format!(
+                        "{} is above {MAX_WEIGHT:e}: weights are relative, keep them within 0 to {MAX_WEIGHT:e}",
+                        num(a.weight)
+                    ),
+                ));
+            }
+            for (k, v, (lo, hi), unit) in [
+                ("max_velocity", a.max_velocity, VELOCITY_RANGE, "mm/s or deg/s"),
+                ("max_acceleration", a.max_acceleration, ACCELERATION_RANGE, "mm/s² or deg/s²"),
+            ] {
                 if let Some(v) = v {
                     if !(v.is_finite() && v > 0.0) {
-                        return Err(invalid(key(k), format!("{v} is not a finite value > 0")));
+                        return Err(invalid(key(k), format!("{} is not a finite value > 0", num(v))));
+                    }
+                    if !(lo..=hi).contains(&v) {
+                        return Err(invalid(key(k), format!("{} is outside {lo:e} to {hi:e} {unit}", num(v))));
                     }
                 }
             }
-            if !a.home.is_finite() {
-                return Err(invalid(key("home"), "not a finite number"));
-            }
+            position(&key("home"), a.home)?;
             for (k, v) in [("min", a.min), ("max", a.max)] {
                 if let Some(v) = v {
-                    if !v.is_finite() {
-                        return Err(invalid(key(k), "not a finite number"));
-                    }
+                    position(&key(k), v)?;
                     if a.kind.wraps() {
                         return Err(invalid(key(k), "continuous and mandrel axes have no travel limits"));
                     }
@@ -252,23 +301,35 @@ impl Machine {
                 return Err(invalid(key("direction"), "direction and origin are for the mandrel axis only"));
             }
             if let Some(d) = a.direction {
+                if !d.iter().all(|v| v.is_finite() && v.abs() <= MAX_AXIS_VALUE) {
+                    return Err(invalid(
+                        key("direction"),
+                        format!("the mandrel direction must be a vector of finite numbers within ±{MAX_AXIS_VALUE:e}"),
+                    ));
+                }
                 let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                if !(n.is_finite() && n > 1e-12) {
-                    return Err(invalid(key("direction"), "the mandrel direction must be a finite non-zero vector"));
+                if n <= 1e-9 {
+                    return Err(invalid(key("direction"), "the mandrel direction must be a non-zero vector"));
                 }
             }
             if let Some(o) = a.origin {
-                if !o.iter().all(|v| v.is_finite()) {
-                    return Err(invalid(key("origin"), "not finite"));
+                for v in o {
+                    position(&key("origin"), v)?;
                 }
             }
         }
         let mut driven = vec![false; self.axes.len()];
         for (j, joint) in self.dh.iter().enumerate() {
             let key = |k: &str| format!("dh[{j}].{k}");
-            for (k, v) in [("a", joint.a), ("d", joint.d), ("alpha", joint.alpha), ("theta", joint.theta)] {
-                if !v.is_finite() {
-                    return Err(invalid(key(k), "not a finite number"));
+            for (k, v) in [("a", joint.a), ("d", joint.d)] {
+                position(&key(k), v)?;
+            }
+            for (k, v) in [("alpha", joint.alpha), ("theta", joint.theta)] {
+                if !(v.is_finite() && v.abs() <= MAX_DH_ANGLE) {
+                    return Err(invalid(
+                        key(k),
+                        format!("{} is not an angle within ±{MAX_DH_ANGLE:e} degrees", num(v)),
+                    ));
                 }
             }
             if let Some(label) = &joint.axis {
@@ -288,8 +349,8 @@ impl Machine {
             }
         }
         if let Some(t) = self.tool_offset {
-            if !t.iter().all(|v| v.is_finite()) {
-                return Err(invalid("tool_offset", "not finite"));
+            for v in t {
+                position("tool_offset", v)?;
             }
         }
         Ok(())
@@ -335,6 +396,25 @@ impl Machine {
     /// Forward kinematics, if the machine has any (a DH chain, or X/Y/Z linear axes).
     pub fn kinematics(&self) -> Option<Kinematics> {
         Kinematics::new(self)
+    }
+}
+
+/// A position value (mm or degrees) must be finite and within ±[`MAX_AXIS_VALUE`].
+fn position(key: &str, v: f64) -> Result<(), MachineError> {
+    if v.is_finite() && v.abs() <= MAX_AXIS_VALUE {
+        Ok(())
+    } else {
+        Err(invalid(key, format!("{} is not a number within ±{MAX_AXIS_VALUE:e}", num(v))))
+    }
+}
+
+/// A number for a message: plain when it reads well, else in exponent form (`1e308`, not 309
+/// digits).
+fn num(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e7).contains(&v.abs()) || !v.is_finite() {
+        v.to_string()
+    } else {
+        format!("{v:e}")
     }
 }
 
@@ -390,17 +470,69 @@ heading = true
             .unwrap_err();
         assert!(matches!(e, MachineError::Syntax { line: 5, .. }), "{e}");
         let e = Machine::from_toml_str(&GANTRY.replace("weight = 1.0", "weight = -1.0")).unwrap_err();
-        assert_eq!(e.to_string(), "axis[0].weight: -1 is not a finite weight ≥ 0");
+        assert_eq!(e.to_string(), "line 6: axis[0].weight: -1 is not a finite weight ≥ 0");
         let e = Machine::from_toml_str(&GANTRY.replace("\"C\"", "\"x\"")).unwrap_err();
         assert!(e.to_string().contains("defined twice"), "{e}");
         let e = Machine::from_toml_str(&GANTRY.replace("kind = \"continuous\"", "kind = \"linear\"")).unwrap_err();
         assert!(e.to_string().contains("heading axis must be rotary"), "{e}");
         let e = Machine::from_toml_str(&format!("{GANTRY}[[dh]]\naxis = \"Q\"\n")).unwrap_err();
-        assert!(e.to_string().starts_with("dh[0].axis"), "{e}");
+        assert!(e.to_string().starts_with("line 14: dh[0].axis"), "{e}");
         let e = Machine::from_toml_str("name = \"m\"\naxis = []\n").unwrap_err();
-        assert!(e.to_string().contains("no axes"), "{e}");
+        assert_eq!(e.to_string(), "line 2: axis: the machine has no axes");
         let e = Machine::from_toml_str(&GANTRY.replace("max_velocity = 1000.0", "max_velocity = nan")).unwrap_err();
         assert!(e.to_string().contains("max_velocity"), "{e}");
+    }
+
+    /// Numbers that are finite but absurd (a weight of 1e308 overflows every cost; a velocity of
+    /// 1e-300 makes every move take forever) are refused with the line that sets them, each
+    /// against its documented range; values just inside the ranges are accepted.
+    #[test]
+    fn numbers_outside_their_ranges_are_refused_with_their_line() {
+        let refused = |from: &str, to: &str, says: &str| {
+            let text = GANTRY.replace(from, to);
+            assert_ne!(text, GANTRY, "{from}");
+            let e = Machine::from_toml_str(&text).unwrap_err().to_string();
+            assert!(e.contains(says), "{to}: {e}");
+        };
+        refused("weight = 1.0", "weight = 1e308", "line 6: axis[0].weight: 1e308 is above 1e6");
+        refused(
+            "max_velocity = 1000.0",
+            "max_velocity = 1e-300",
+            "line 7: axis[0].max_velocity: 1e-300 is outside 1e-3 to 1e7 mm/s or deg/s",
+        );
+        refused("max_velocity = 1000.0", "max_velocity = 1e300", "line 7: axis[0].max_velocity");
+        refused("max_acceleration = 2000.0", "max_acceleration = 1e10", "line 8: axis[0].max_acceleration");
+        refused(
+            "heading = true",
+            "heading = true\nhome = 1e8",
+            "line 13: axis[1].home: 1e8 is not a number within ±1e7",
+        );
+        refused("heading = true", "heading = true\nkind2 = 1", "line 13");
+        let with = |extra: &str| Machine::from_toml_str(&format!("{GANTRY}{extra}"));
+        let e = with("[[dh]]\na = 2e7\n").unwrap_err().to_string();
+        assert!(e.starts_with("line 14: dh[0].a: 2e7 is not a number within ±1e7"), "{e}");
+        let e = with("[[dh]]\nalpha = 1e300\n").unwrap_err().to_string();
+        assert!(e.starts_with("line 14: dh[0].alpha: 1e300 is not an angle"), "{e}");
+        let e = Machine::from_toml_str(&format!("tool_offset = [0, 0, 1e9]{GANTRY}")).unwrap_err().to_string();
+        assert_eq!(e, "line 1: tool_offset: 1e9 is not a number within ±1e7");
+        let mandrel = "[[axis]]\nlabel = \"A\"\nkind = \"mandrel\"\norigin = [0, 1e300, 0]\n";
+        let e = with(mandrel).unwrap_err().to_string();
+        assert!(e.starts_with("line 16: axis[2].origin: 1e300"), "{e}");
+        let e = with(&mandrel.replace("origin = [0, 1e300, 0]", "direction = [1e-300, 0, 0]")).unwrap_err().to_string();
+        assert!(e.starts_with("line 16: axis[2].direction"), "{e}");
+        // At the edges of the ranges: accepted.
+        let edge = GANTRY
+            .replace("weight = 1.0", "weight = 1e6")
+            .replace("max_velocity = 1000.0", "max_velocity = 1e7")
+            .replace("max_acceleration = 2000.0", "max_acceleration = 1e-3");
+        Machine::from_toml_str(&edge).unwrap();
+        // A machine built in code has no line to name.
+        let mut x = Axis::new("X", AxisKind::Linear);
+        x.weight = 1e7;
+        assert_eq!(
+            Machine::new("m", vec![x]).unwrap_err().to_string(),
+            "axis[0].weight: 1e7 is above 1e6: weights are relative, keep them within 0 to 1e6"
+        );
     }
 
     /// Every key a machine file can hold, collected from a machine that sets them all.

@@ -26,9 +26,13 @@
 mod config;
 mod cost;
 mod kinematics;
+mod locate;
 mod motion;
 
-pub use config::{Axis, AxisKind, DhJoint, Machine, MachineError};
+pub use config::{
+    Axis, AxisKind, DhJoint, Machine, MachineError, ACCELERATION_RANGE, MAX_AXES, MAX_AXIS_VALUE, MAX_DH_ANGLE,
+    MAX_WEIGHT, VELOCITY_RANGE,
+};
 pub use cost::{CostError, CostKind, MachineCost, StateTable};
 pub use kinematics::Kinematics;
 pub use motion::trapezoid_time;

@@ -1,11 +1,11 @@
-//! Built-in demo parts modelled on seed 000 §4.5, and large generated parts for benchmarks.
+//! Built-in demo parts modelled on Doherty et al. (2022) §4.5, and large generated parts for benchmarks.
 //!
 //! Each part is a program in the reference dialect for one of two machines: a planar gantry
 //! (X, Y, Z, heading C) and a mandrel machine (X along the mandrel, Z radial, heading C, mandrel
 //! A). Plies are rectangles of the surface (the plan, or the unrolled cylinder) filled with
 //! parallel courses of 8 tows of 6.35 mm at the ply angle; each tow is cut where its centre
 //! line leaves the rectangle (so angled courses drop tows one by one). The programs are laid
-//! the way seed 000's test programs were planned badly: every course in the same direction,
+//! the way Doherty et al.'s test programs were planned badly: every course in the same direction,
 //! plies in an illogical order.
 
 use towpath_machine::{Axis, AxisKind, Machine};
@@ -46,7 +46,7 @@ pub struct DemoPart {
     pub name: String,
     /// What it is.
     pub description: String,
-    /// The seed-000 figure it is modelled on, with the published savings (off-part %, total %).
+    /// The figure of Doherty et al. (2022) it is modelled on, with the published savings (off-part %, total %).
     pub seed: Option<(&'static str, f64, f64)>,
     /// The machine.
     pub machine: Machine,
@@ -238,7 +238,7 @@ fn ply(label: &str, rect: [f64; 4], angle: f64) -> PlySpec {
     PlySpec { label: label.into(), rect, angle }
 }
 
-/// Seed 000 §4.5's planar parts: a 1200 × 800 base ply and three non-intersecting pad-ups
+/// Doherty et al.'s (2022) §4.5 planar parts: a 1200 × 800 base ply and three non-intersecting pad-ups
 /// placed badly, at one angle.
 fn planar(angle: f64, equidistant: bool) -> Vec<PlySpec> {
     let pads: [[f64; 4]; 3] = if equidistant {

@@ -78,6 +78,17 @@ pub struct Clearance {
     pub value: f64,
 }
 
+/// A pair of codes that switch something on and off along a course's path (a heater, a
+/// cutter, coolant): `[[switch]]` in the dialect file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Switch {
+    /// The code that switches it on (`"M8"`).
+    pub on: String,
+    /// The code that switches it off (`"M9"`).
+    pub off: String,
+}
+
 fn s(x: &str) -> String {
     x.to_string()
 }
@@ -151,6 +162,14 @@ pub struct Dialect {
     /// A clearance for the transits towpath writes: up to this value of this axis, across, and
     /// down (none: one straight rapid move).
     pub clearance: Option<Clearance>,
+    /// M codes that act at their point of a course's path and mean the same whichever way the
+    /// course is laid (a stop, a message to the operator): kept at their point when a course is
+    /// reversed. Other codes towpath does not know keep a course forward.
+    pub point_codes: Vec<String>,
+    /// On/off pairs of M codes that switch something along a course's path: reversed, each
+    /// pair's on and off lines trade places so the same stretch runs with it on.
+    #[serde(rename = "switch")]
+    pub switches: Vec<Switch>,
 }
 
 impl Default for Dialect {
@@ -185,6 +204,8 @@ impl Default for Dialect {
             decimals: 4,
             non_motion_codes: vec![s("G4")],
             clearance: None,
+            point_codes: Vec::new(),
+            switches: Vec::new(),
         }
     }
 }
@@ -206,6 +227,12 @@ pub(crate) struct Codes {
     pub restart: Code,
     pub cut: Code,
     pub mask_word: char,
+    /// G codes whose axis words are not positions (a dwell).
+    pub non_motion: Vec<Code>,
+    /// Codes that act at a point and mean the same either way.
+    pub point: Vec<Code>,
+    /// Switch pairs (on, off).
+    pub switches: Vec<(Code, Code)>,
 }
 
 impl Dialect {
@@ -296,6 +323,23 @@ impl Dialect {
             restart: code("tow_restart", &self.tow_restart)?,
             cut: code("tow_cut", &self.tow_cut)?,
             mask_word: letter("tow_mask_word", &self.tow_mask_word)?,
+            non_motion: self
+                .non_motion_codes
+                .iter()
+                .map(|x| {
+                    Code::parse(x)
+                        .ok_or_else(|| NcError::Dialect(format!("non_motion_codes: {x:?} is not a code like G4")))
+                })
+                .collect::<Result<_, _>>()?,
+            point: any("point_codes", &self.point_codes)?,
+            switches: self
+                .switches
+                .iter()
+                .enumerate()
+                .map(|(i, sw)| {
+                    Ok((code(&format!("switch[{i}].on"), &sw.on)?, code(&format!("switch[{i}].off"), &sw.off)?))
+                })
+                .collect::<Result<_, NcError>>()?,
         };
         self.check_roles(&codes)?;
         Ok(codes)
@@ -305,13 +349,7 @@ impl Dialect {
     /// codes are G codes, contact and tow codes M codes); the word letters differ from each
     /// other and from G and M; ply and course comments differ.
     fn check_roles(&self, c: &Codes) -> Result<(), NcError> {
-        let non_motion = self
-            .non_motion_codes
-            .iter()
-            .map(|x| {
-                Code::parse(x).ok_or_else(|| NcError::Dialect(format!("non_motion_codes: {x:?} is not a code like G4")))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let non_motion = c.non_motion.clone();
         let mut roles: Vec<(&str, Code, char)> = Vec::new();
         for (key, list) in [
             ("rapid", &c.rapid),
@@ -332,6 +370,13 @@ impl Dialect {
         }
         roles.push(("tow_restart", c.restart, 'M'));
         roles.push(("tow_cut", c.cut, 'M'));
+        roles.extend(c.point.iter().map(|&x| ("point_codes", x, 'M')));
+        let switch_keys: Vec<(String, String)> =
+            (0..c.switches.len()).map(|i| (format!("switch[{i}].on"), format!("switch[{i}].off"))).collect();
+        for ((on, off), (kon, koff)) in c.switches.iter().zip(&switch_keys) {
+            roles.push((kon.as_str(), *on, 'M'));
+            roles.push((koff.as_str(), *off, 'M'));
+        }
         for (i, &(key, x, letter)) in roles.iter().enumerate() {
             if x.letter != letter {
                 let article = if letter == 'M' { "an" } else { "a" };

@@ -191,36 +191,115 @@ pub struct Footprints {
     pub courses: Vec<Footprint>,
 }
 
+/// The narrowest course (one tow of a tow width, or a course width) towpath accepts, mm: twice
+/// the overlap tolerance, since every footprint is shrunk by half of it on each side.
+pub const MIN_WIDTH: f64 = 2.0 * OVERLAP_TOLERANCE;
+
+/// A course width may be at most this many times the span of the whole laid part (the diagonal
+/// of its laid centre lines in the footprint frame).
+pub const MAX_WIDTH_PER_SPAN: f64 = 2.0;
+
+/// At most this many footprint rectangles in a program: beyond it, laid moves are split into
+/// longer pieces (the footprints stay exact; only spatial indexes get looser).
+pub const MAX_PIECES: usize = 1_000_000;
+
+/// Every laid move of the program: (course, segment index, course width there), in program
+/// order. A course that restarts tows lays where tows are on; one that restarts none (a
+/// dialect without tow codes in use) lays wherever the roller is in contact.
+fn laid_moves(program: &Program, width: Option<Width>) -> Vec<(usize, usize, f64)> {
+    let mut out = Vec::new();
+    for (c, course) in program.courses.iter().enumerate() {
+        let segs = course.segments.clone();
+        let has_tows = program.segments[segs.clone()].iter().any(|s| s.on_part && s.mask != 0);
+        for i in segs {
+            let s = &program.segments[i];
+            if s.on_part && (!has_tows || s.mask != 0) {
+                let w = match width {
+                    Some(Width::Course(w)) => w,
+                    Some(Width::Tow(t)) => t * s.mask.count_ones().max(1) as f64,
+                    None => 0.0,
+                };
+                out.push((c, i, w));
+            }
+        }
+    }
+    out
+}
+
 /// The part-frame frame for a machine and program: plan, or an unrolled cylinder around the
-/// mandrel at the median radius of the laid points.
-pub fn frame_for(program: &Program, machine: &Machine, kin: &Kinematics) -> Frame {
+/// mandrel at the median radius of the laid points. Refused when a laid point lies closer to
+/// the mandrel axis than its course width / 2π (its course would wrap the whole mandrel there;
+/// without a width: closer than 1 µm), naming the line: the footprints cannot be unrolled.
+pub fn frame_for(
+    program: &Program,
+    machine: &Machine,
+    kin: &Kinematics,
+    width: Option<Width>,
+) -> Result<Frame, NcError> {
     let Some((origin, dir)) = kin.mandrel_axis() else {
-        return Frame::Plan;
+        return Ok(Frame::Plan);
     };
     // e1: any unit vector across the axis.
     let pick = if dir[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
     let e1 = normalize(sub(pick, scale(dir, dot(pick, dir))));
     let e2 = cross(dir, e1);
-    let mut radii: Vec<f64> = program
-        .segments
-        .iter()
-        .filter(|s| s.on_part)
-        .map(|s| {
-            let p = kin.part_point(program.point(s.to));
-            let d = sub(p, origin);
-            let r = sub(d, scale(dir, dot(d, dir)));
-            dot(r, r).sqrt()
-        })
-        .filter(|r| r.is_finite())
-        .collect();
+    let radius_of = |i: u32| {
+        let p = kin.part_point(program.point(i));
+        let d = sub(p, origin);
+        let r = sub(d, scale(dir, dot(d, dir)));
+        dot(r, r).sqrt()
+    };
+    let mut radii: Vec<f64> = Vec::new();
+    for (_, i, w) in laid_moves(program, width) {
+        let s = &program.segments[i];
+        for p in [s.from, s.to] {
+            let r = radius_of(p);
+            let min = (w / std::f64::consts::TAU).max(1e-3);
+            if r.is_nan() || r < min {
+                return Err(NcError::MandrelAxis {
+                    line: s.line as usize + 1,
+                    radius: r,
+                    width: w,
+                    axis: machine.mandrel_axis().unwrap_or(0),
+                    label: machine.mandrel_axis().map_or_else(String::new, |i| machine.axes[i].label.clone()),
+                    origin,
+                    direction: dir,
+                });
+            }
+        }
+        radii.push(radius_of(s.to));
+    }
     radii.sort_by(f64::total_cmp);
-    let radius = radii.get(radii.len() / 2).copied().filter(|r| *r > 1e-6).unwrap_or(1.0);
-    let _ = machine;
-    Frame::Cylinder { origin, dir, e1, e2, radius }
+    // Nothing laid: no footprint depends on the radius.
+    let radius = radii.get(radii.len() / 2).copied().unwrap_or(1.0);
+    Ok(Frame::Cylinder { origin, dir, e1, e2, radius })
 }
 
-/// Builds the footprints of every course. Needs the machine's kinematics and a width.
+/// Builds the footprints of every course. Needs the machine's kinematics and a width; refuses a
+/// width narrower than [`MIN_WIDTH`] or wider than [`MAX_WIDTH_PER_SPAN`] times the laid part,
+/// and laid points on or near a mandrel's axis (closer than the course width / 2π, where the unrolled course would wrap the whole mandrel).
 pub fn footprints(program: &Program, machine: &Machine, width: Width) -> Result<Footprints, NcError> {
+    footprints_within(program, machine, width, MAX_PIECES)
+}
+
+/// [`footprints`] with at most about `max_pieces` rectangles (one more per laid move at most).
+pub(crate) fn footprints_within(
+    program: &Program,
+    machine: &Machine,
+    width: Width,
+    max_pieces: usize,
+) -> Result<Footprints, NcError> {
+    let narrowest = match width {
+        Width::Tow(t) | Width::Course(t) => t,
+    };
+    if !(narrowest.is_finite() && narrowest >= MIN_WIDTH) {
+        return Err(NcError::ImplausibleWidth {
+            width: narrowest,
+            problem: format!(
+                "is narrower than {MIN_WIDTH} mm (twice the {OVERLAP_TOLERANCE} mm overlap tolerance): its footprints would vanish"
+            ),
+        });
+    }
     let kin = machine.kinematics().ok_or_else(|| {
         NcError::Machine(
             "course footprints need the tool point: give the machine a DH chain or X/Y/Z linear axes \
@@ -228,9 +307,7 @@ pub fn footprints(program: &Program, machine: &Machine, width: Width) -> Result<
                 .into(),
         )
     })?;
-    let frame = frame_for(program, machine, &kin);
-    let mut courses = Vec::with_capacity(program.courses.len());
-    for (c, course) in program.courses.iter().enumerate() {
+    for course in &program.courses {
         let segs = &program.segments[course.segments.clone()];
         let has_tows = segs.iter().any(|s| s.on_part && s.mask != 0);
         if !has_tows && matches!(width, Width::Tow(_)) && segs.iter().any(|s| s.on_part) {
@@ -239,47 +316,110 @@ pub fn footprints(program: &Program, machine: &Machine, width: Width) -> Result<
                 course.on_part.start + 1
             )));
         }
-        let mut fp = Footprint::default();
-        let mut path: Vec<[f64; 2]> = Vec::new();
-        let mut last_v: Option<f64> = None;
-        for s in segs {
-            let laid = s.on_part && (!has_tows || s.mask != 0);
-            if !laid {
+    }
+    let frame = frame_for(program, machine, &kin, Some(width))?;
+    // Every laid move in the frame (unwrapped along its course), and the part's span.
+    let laid = laid_moves(program, Some(width));
+    let mut mapped: Vec<([f64; 2], [f64; 2])> = Vec::with_capacity(laid.len());
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    // The course and the end of its last laid move (unwrapped), to unwrap the next one near it.
+    let mut last: Option<(usize, f64)> = None;
+    for &(c, i, _) in &laid {
+        let s = &program.segments[i];
+        let mut a = frame.map(kin.part_point(program.point(s.from)));
+        let mut b = frame.map(kin.part_point(program.point(s.to)));
+        if let Some((_, v)) = last.filter(|l| l.0 == c) {
+            a[1] = frame.unwrap_near(a[1], v);
+        }
+        b[1] = frame.unwrap_near(b[1], a[1]);
+        last = Some((c, b[1]));
+        for p in [a, b] {
+            for k in 0..2 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        mapped.push((a, b));
+    }
+    let widest = laid.iter().map(|l| l.2).fold(0.0, f64::max);
+    if lo[0].is_finite() {
+        let span = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2)).sqrt();
+        if span > OVERLAP_TOLERANCE && widest > MAX_WIDTH_PER_SPAN * span {
+            return Err(NcError::ImplausibleWidth {
+                width: widest,
+                problem: format!(
+                    "is more than {MAX_WIDTH_PER_SPAN} times the whole laid part, whose laid paths span {span:.3} mm{}: \
+                     a width in other units?",
+                    if frame.period().is_some() { " on the unrolled mandrel" } else { " in plan" }
+                ),
+            });
+        }
+    }
+    // Pieces no longer than four widths (at most 100,000 per move), unless that makes more than
+    // `max_pieces` in all: then each move gets its share of them.
+    let length = |(a, b): &([f64; 2], [f64; 2])| ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+    let natural: Vec<usize> = laid
+        .iter()
+        .zip(&mapped)
+        .map(|(l, m)| {
+            let inner = length(m) - OVERLAP_TOLERANCE;
+            if inner > 0.0 {
+                ((inner / (4.0 * l.2.max(1e-3))).ceil() as usize).clamp(1, 100_000)
+            } else {
+                0
+            }
+        })
+        .collect();
+    let total = natural.iter().fold(0usize, |a, &b| a.saturating_add(b));
+    let share = |n: usize| {
+        if total > max_pieces {
+            ((n as f64 * max_pieces as f64 / total as f64) as usize).max(1)
+        } else {
+            n
+        }
+    };
+
+    let mut courses: Vec<Footprint> = vec![Footprint::default(); program.courses.len()];
+    let mut path: Vec<[f64; 2]> = Vec::new();
+    let mut prev: Option<(usize, usize)> = None;
+    for ((&(c, i, w), &(a, b)), &n) in laid.iter().zip(&mapped).zip(&natural) {
+        // A new polyline where the course changes or a laid move does not follow the last one.
+        let joined = prev.is_some_and(|(pc, pi)| pc == c && pi + 1 == i);
+        if !joined {
+            if let Some((pc, _)) = prev {
                 if path.len() > 1 {
-                    fp.paths.push(std::mem::take(&mut path));
+                    courses[pc].paths.push(std::mem::take(&mut path));
                 }
-                path.clear();
-                continue;
             }
-            let w = match width {
-                Width::Course(w) => w,
-                Width::Tow(t) => t * s.mask.count_ones() as f64,
-            };
-            let mut a = frame.map(kin.part_point(program.point(s.from)));
-            let mut b = frame.map(kin.part_point(program.point(s.to)));
-            if let Some(v) = last_v {
-                a[1] = frame.unwrap_near(a[1], v);
-            }
-            b[1] = frame.unwrap_near(b[1], a[1]);
-            last_v = Some(b[1]);
-            if path.is_empty() {
-                path.push(a);
-            }
-            path.push(b);
-            add_quads(&mut fp, a, b, w);
+            path.clear();
         }
+        if path.is_empty() {
+            path.push(a);
+        }
+        path.push(b);
+        add_pieces(&mut courses[c], a, b, w, share(n));
+        prev = Some((c, i));
+    }
+    if let Some((pc, _)) = prev {
         if path.len() > 1 {
-            fp.paths.push(path);
+            courses[pc].paths.push(path);
         }
-        let _ = c;
-        courses.push(fp);
     }
     Ok(Footprints { frame, courses })
 }
 
 /// Adds the shrunk rectangles of one laid move from `a` to `b` of width `w`, split into pieces
 /// no longer than four widths (so spatial indexes stay tight).
+#[cfg(test)]
 fn add_quads(fp: &mut Footprint, a: [f64; 2], b: [f64; 2], w: f64) {
+    let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+    let pieces = (((len - OVERLAP_TOLERANCE) / (4.0 * w.max(1e-3))).ceil() as usize).clamp(1, 100_000);
+    add_pieces(fp, a, b, w, pieces)
+}
+
+/// Adds the shrunk rectangles of one laid move from `a` to `b` of width `w`, in `pieces`
+/// pieces of equal length (the whole move's rectangle goes to `moves`).
+fn add_pieces(fp: &mut Footprint, a: [f64; 2], b: [f64; 2], w: f64, pieces: usize) {
     let shrink = OVERLAP_TOLERANCE / 2.0;
     let d = [b[0] - a[0], b[1] - a[1]];
     let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
@@ -289,7 +429,7 @@ fn add_quads(fp: &mut Footprint, a: [f64; 2], b: [f64; 2], w: f64) {
     }
     let u = [d[0] / len, d[1] / len];
     let inner = len - OVERLAP_TOLERANCE;
-    let pieces = ((inner / (4.0 * w.max(1e-3))).ceil() as usize).clamp(1, 100_000);
+    let pieces = pieces.max(1);
     let piece = inner / pieces as f64;
     let m = fp.moves.len() as u32;
     fp.moves.push(Quad { c: [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0], u, hl: inner / 2.0, hw });
@@ -347,6 +487,78 @@ mod tests {
         assert_eq!(a.quads.len(), 3);
         assert_eq!(a.moves.len(), 1);
         assert_eq!(a.move_of, vec![0, 0, 0]);
+    }
+
+    fn xyz() -> Machine {
+        use towpath_machine::{Axis, AxisKind};
+        Machine::new("m", ["X", "Y", "Z"].iter().map(|l| Axis::new(l, AxisKind::Linear)).collect()).unwrap()
+    }
+
+    /// One tow laid in a straight line from `a` to `b` (plan coordinates).
+    fn course(a: [f64; 2], b: [f64; 2]) -> String {
+        format!(
+            "G0 X{} Y{} Z10\nG1 Z0 F1000\nM20\nM60 P1\nG1 X{} Y{} F3000\nM61 P1\nM21\nG1 Z10\n",
+            a[0], a[1], b[0], b[1]
+        )
+    }
+
+    /// Capped at a few pieces, long moves are split into longer pieces that still make up
+    /// exactly each move, and precedence comes out the same.
+    #[test]
+    fn capped_pieces_still_make_up_each_move() {
+        let mut text = String::from("G90\n(PLY 1)\n");
+        for k in 0..4 {
+            text.push_str(&course([0.0, 10.0 * k as f64], [5000.0, 10.0 * k as f64]));
+        }
+        text.push_str("(PLY 2)\n");
+        for k in 0..4 {
+            text.push_str(&course([1000.0 * k as f64, -5.0], [1000.0 * k as f64 + 300.0, 40.0]));
+        }
+        let m = xyz();
+        let p = crate::parse::parse(&text, &m, &crate::Dialect::default()).unwrap();
+        let free = footprints(&p, &m, Width::Course(2.0)).unwrap();
+        let capped = footprints_within(&p, &m, Width::Course(2.0), 40).unwrap();
+        let count = |f: &Footprints| f.courses.iter().map(|c| c.quads.len()).sum::<usize>();
+        assert!(count(&free) > 2000, "{}", count(&free));
+        assert!(count(&capped) <= 40 + 8, "{}", count(&capped));
+        for (a, b) in free.courses.iter().zip(&capped.courses) {
+            assert_eq!(a.moves, b.moves);
+            for (mi, mv) in b.moves.iter().enumerate() {
+                let pieces: Vec<&Quad> =
+                    b.quads.iter().zip(&b.move_of).filter(|(_, &m)| m as usize == mi).map(|(q, _)| q).collect();
+                let total: f64 = pieces.iter().map(|q| 2.0 * q.hl).sum();
+                assert!((total - 2.0 * mv.hl).abs() < 1e-6, "{total} {}", 2.0 * mv.hl);
+                assert!(pieces.iter().all(|q| q.hw == mv.hw && q.u == mv.u));
+            }
+        }
+        let plies: Vec<Vec<usize>> = p.plies.iter().map(|p| p.courses.clone()).collect();
+        let mut e1 = crate::precedence::course_precedence(&free, &plies).unwrap();
+        let mut e2 = crate::precedence::course_precedence(&capped, &plies).unwrap();
+        e1.sort_unstable();
+        e2.sort_unstable();
+        assert_eq!(e1, e2);
+        assert!(!e1.is_empty());
+    }
+
+    /// Widths narrower than twice the overlap tolerance, or far wider than the part, are refused;
+    /// the bounds themselves are accepted.
+    #[test]
+    fn widths_are_checked_against_the_tolerance_and_the_part() {
+        let mut text = String::from("G90\n(PLY 1)\n");
+        text.push_str(&course([0.0, 0.0], [300.0, 0.0]));
+        text.push_str(&course([0.0, 40.0], [300.0, 40.0]));
+        let m = xyz();
+        let p = crate::parse::parse(&text, &m, &crate::Dialect::default()).unwrap();
+        // The laid paths span the diagonal of (0, 0)–(300, 40).
+        let span = (300.0f64 * 300.0 + 40.0 * 40.0).sqrt();
+        assert!(footprints(&p, &m, Width::Course(MAX_WIDTH_PER_SPAN * span * 0.999)).is_ok());
+        let e = footprints(&p, &m, Width::Course(MAX_WIDTH_PER_SPAN * span * 1.001)).unwrap_err();
+        assert!(matches!(e, NcError::ImplausibleWidth { .. }) && e.to_string().contains("302.655 mm in plan"), "{e}");
+        let e = footprints(&p, &m, Width::Course(1e20)).unwrap_err();
+        assert!(e.to_string().starts_with("a course width of 1e20 mm is more than 2 times"), "{e}");
+        assert!(footprints(&p, &m, Width::Tow(MIN_WIDTH)).is_ok());
+        let e = footprints(&p, &m, Width::Tow(MIN_WIDTH * 0.9)).unwrap_err();
+        assert!(e.to_string().contains("is narrower than 0.02 mm"), "{e}");
     }
 
     #[test]

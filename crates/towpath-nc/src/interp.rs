@@ -12,8 +12,12 @@ use crate::dialect::{Codes, Dialect, EventTiming};
 use crate::error::NcError;
 use crate::lex::{lex, Lexed, NumText, Word};
 
-/// Largest axis value accepted, in mm or degrees.
-pub const MAX_AXIS_VALUE: f64 = 1e7;
+/// Largest axis value accepted, in mm or degrees (the machine file's range).
+pub const MAX_AXIS_VALUE: f64 = towpath_machine::MAX_AXIS_VALUE;
+
+/// Most chords a program's arcs may be split into (within [`ARC_CHORD_TOLERANCE`] each): the
+/// bound on the memory the moves of a program's arcs take.
+pub const MAX_ARC_CHORDS: usize = 1_000_000;
 
 /// Words of an arc: centre offsets from the start (I along X, J along Y, K along Z) or radius.
 const ARC_WORDS: &str = "IJKR";
@@ -145,6 +149,8 @@ pub struct Interp<'a> {
     letters: Vec<char>,
     kinds: Vec<AxisKind>,
     non_motion: Vec<crate::dialect::Code>,
+    /// Arc chords made so far.
+    chords: usize,
     /// The current state.
     pub m: Modal,
 }
@@ -186,6 +192,7 @@ impl<'a> Interp<'a> {
             letters,
             kinds: machine.axes.iter().map(|a| a.kind).collect(),
             non_motion,
+            chords: 0,
             m: Modal::home(machine),
         })
     }
@@ -220,7 +227,7 @@ impl<'a> Interp<'a> {
                     }
                 }
                 if self.m.contact || self.m.mask != 0 {
-                    return Err(NcError::line(n, format!("{} inside a course", issue.message)));
+                    return Err(NcError::InCourse { line: n, message: issue.message });
                 }
                 return Ok(Applied { unknown: true, ..Applied::default() });
             }
@@ -436,6 +443,30 @@ impl<'a> Interp<'a> {
                 self.events(n, &events)?;
                 out.before = events.clone();
             }
+            // A rapid move may not touch the part: not with the roller in contact, nor (without
+            // contact codes) with tows on.
+            if rapid {
+                let code = self.dialect.rapid.first().map_or("G0", String::as_str);
+                if self.codes.contact.is_some() && self.m.contact {
+                    return Err(NcError::InCourse {
+                        line: n,
+                        message: format!(
+                            "a rapid move ({code}) while the roller is in contact: rapids do not lay material or \
+                             press the roller; write it as a feed move"
+                        ),
+                    });
+                }
+                if self.m.mask != 0 {
+                    return Err(NcError::InCourse {
+                        line: n,
+                        message: format!(
+                            "a rapid move ({code}) while tows are on (mask {}): rapids do not lay material; write it \
+                             as a feed move",
+                            self.m.mask
+                        ),
+                    });
+                }
+            }
             // The state where an arc starts (straight moves need none).
             let start = if arc_move { Some((self.m.prog.clone(), self.m.phys.clone())) } else { None };
             if arc_move {
@@ -471,6 +502,16 @@ impl<'a> Interp<'a> {
             if let (Some(cw), Some((prog, phys))) = (self.m.arc, &start) {
                 out.arc = true;
                 out.path = self.arc_path(n, prog, phys, cw, &arc_words)?;
+                self.chords += out.path.len() + 1;
+                if self.chords > MAX_ARC_CHORDS {
+                    return Err(NcError::line(
+                        n,
+                        format!(
+                            "the program's arcs need more than {MAX_ARC_CHORDS} chords to be followed within \
+                             {ARC_CHORD_TOLERANCE} mm: too many arcs (or arcs too large) for towpath to read"
+                        ),
+                    ));
+                }
             }
             if timing == EventTiming::After {
                 self.events(n, &events)?;

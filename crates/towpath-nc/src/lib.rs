@@ -24,20 +24,28 @@ mod reverse;
 mod rewrite;
 mod sequencer;
 mod verify;
+mod verify_lines;
+mod width;
 
-pub use dialect::{Clearance, Code, Dialect, EventTiming, FeedUnit};
+pub use dialect::{Clearance, Code, Dialect, EventTiming, FeedUnit, Switch};
 pub use error::NcError;
-pub use footprint::{footprints, Footprint, Footprints, Frame, Quad, Width, OVERLAP_TOLERANCE};
+pub use footprint::{
+    footprints, Footprint, Footprints, Frame, Quad, Width, MAX_PIECES, MAX_WIDTH_PER_SPAN, MIN_WIDTH, OVERLAP_TOLERANCE,
+};
 pub use interp::{Event, Interp, Marker, Modal};
 pub use lex::{lex, LexIssue, Lexed, NumText, Word};
-pub use optimize::{apply_steps, auto_time_limit, optimize, OptimizeOptions, Optimized, SolverSummary, Timings};
+pub use optimize::{
+    apply_steps, auto_time_limit, fallback_reason, optimize, Fallback, OptimizeOptions, Optimized, SolverSummary,
+    Timings,
+};
 pub use parse::parse;
-pub use precedence::{course_precedence, precedence_sets};
-pub use problem::{build_problem, placements, AfpOptions, AfpProblem, PrecedenceRule};
-pub use program::{ply_name, Course, Item, Ply, Program, Region, Segment};
-pub use report::{totals, GroupCost, GroupRow, OrderRow, Report, Totals};
-pub use reverse::{reversal_of, reverse_course, Reversed};
+pub use precedence::{course_precedence, precedence_sets, MAX_VISITS};
+pub use problem::{build_problem, default_cost, placements, AfpOptions, AfpProblem, PrecedenceRule};
+pub use program::{ply_name, Course, Item, LineBreak, Ply, Program, Region, Segment, SwitchKey};
+pub use report::{cost_words, headline, totals, totals_table, GroupCost, GroupRow, OrderRow, Report, Totals};
+pub use reverse::{reversal_of, reverse_course, Irreversible, Reversed};
 pub use rewrite::{rewrite, Placement};
 pub use sequencer::{seed000_sets, sequence};
 pub use towpath_baselines::{BaselineParams, SolverName};
 pub use verify::{measure, verify, verify_parsed, Motion, Verification, VerifyError, VerifyOptions};
+pub use width::{WidthSource, WidthUsed, PLAUSIBLE_FACTOR};

@@ -4,7 +4,7 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 use towpath_baselines::{BaselineParams, SolverName};
-use towpath_machine::Machine;
+use towpath_machine::{CostKind, Machine};
 use towpath_seq::{check, SolveOptions, Step};
 
 use crate::dialect::Dialect;
@@ -30,10 +30,10 @@ pub struct OptimizeOptions {
     pub threads: usize,
     /// Called as the solver progresses.
     pub progress: Option<towpath_seq::ProgressFn>,
-    /// The solver: towpath's own (default) or one of the seed papers' (for comparison).
+    /// The solver: towpath's own (default) or one of the published solvers (for comparison).
     pub solver: SolverName,
-    /// Parameters of the seed papers' solvers. `doherty` without `sets` gets the program's
-    /// seed-000 precedence sets ([`crate::seed000_sets`]).
+    /// Parameters of the published solvers (docs/references.md). `doherty` without `sets` gets the program's
+    /// Doherty et al.'s precedence sets ([`crate::seed000_sets`]).
     pub baselines: BaselineParams,
 }
 
@@ -124,11 +124,19 @@ pub struct Optimized {
     /// The solver's order measured worse than the input on the program itself, so the input
     /// was returned unchanged.
     pub fell_back: bool,
+    /// Why the input was returned unchanged (when [`Optimized::fell_back`]).
+    pub fallback: Option<Fallback>,
+    /// The course width used and where it came from (with a warning if the width given
+    /// disagrees with the dialect's).
+    pub width: crate::width::WidthUsed,
 }
 
 /// Optimizes a program: returns the rewritten text, verified against the input, never costing
-/// more off-part motion (under the chosen cost model) than the input. The courses are
-/// sequenced by `opts.solver` (towpath's own by default).
+/// more off-part motion (under the chosen cost model) than the input and, when the machine has
+/// velocities, never taking longer (cycle time under the machine's time model, as the verifier
+/// measures it) than the input, whatever the cost optimized: otherwise the input order is
+/// returned unchanged ([`Optimized::fallback`] says why). The courses are sequenced by
+/// `opts.solver` (towpath's own by default).
 pub fn optimize(
     text: &str,
     machine: &Machine,
@@ -137,6 +145,7 @@ pub fn optimize(
 ) -> Result<Optimized, NcError> {
     let t0 = Instant::now();
     let program = crate::parse::parse(text, machine, dialect)?;
+    let width = crate::width::WidthUsed::choose(opts.afp.width, dialect, &program);
     let t_parse = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let afp = build_problem(&program, machine, dialect, &opts.afp)?;
@@ -183,14 +192,11 @@ pub fn optimize(
             .map_err(|e| NcError::SelfCheck(e.to_string()))
     };
     let mut verification = check(&out)?;
-    let mut fell_back = false;
-    if let Some((before, after)) = verification.motion(opts.afp.cost) {
-        if after.off_part() > before.off_part() * (1.0 + 1e-12) + 1e-9 {
-            fell_back = true;
-            order = (0..program.courses.len()).map(|c| Placement { course: c, reversed: false }).collect();
-            out = text.to_string();
-            verification = check(&out)?;
-        }
+    let fallback = fallback_reason(&verification, opts.afp.cost);
+    if fallback.is_some() {
+        order = (0..program.courses.len()).map(|c| Placement { course: c, reversed: false }).collect();
+        out = text.to_string();
+        verification = check(&out)?;
     }
     let t_verify = t4.elapsed().as_secs_f64();
     Ok(Optimized {
@@ -208,12 +214,73 @@ pub fn optimize(
             verify: t_verify,
             total: t0.elapsed().as_secs_f64(),
         },
-        fell_back,
+        fell_back: fallback.is_some(),
+        fallback,
+        width,
     })
 }
 
+/// Why the solver's order is not returned, if it is not: measured on the rewritten program by
+/// the verifier, it costs more off-part motion than the input under the optimized cost, or its
+/// cycle time (the machine's time model, when the machine has velocities) is longer than the
+/// input's, whatever cost was optimized.
+pub fn fallback_reason(v: &Verification, cost: CostKind) -> Option<Fallback> {
+    let worse = |before: f64, after: f64| after > before * (1.0 + 1e-12) + 1e-9;
+    if let Some((before, after)) = v.motion(CostKind::Time) {
+        if worse(before.total(), after.total()) {
+            return Some(Fallback::CycleTime { before: before.total(), after: after.total() });
+        }
+    }
+    let (before, after) = v.motion(cost)?;
+    worse(before.off_part(), after.off_part()).then(|| Fallback::Cost {
+        kind: cost,
+        before: before.off_part(),
+        after: after.off_part(),
+    })
+}
+
+/// Why [`optimize`] returned the input unchanged.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(tag = "reason", rename_all = "snake_case")]
+pub enum Fallback {
+    /// The solver's order, as written, had a longer cycle time than the input (seconds, under
+    /// the machine's time model).
+    CycleTime {
+        /// The input's cycle time.
+        before: f64,
+        /// The solver's order's cycle time.
+        after: f64,
+    },
+    /// The solver's order, as written, cost more off-part motion than the input under the
+    /// optimized cost.
+    Cost {
+        /// The cost model.
+        kind: CostKind,
+        /// The input's off-part motion.
+        before: f64,
+        /// The solver's order's off-part motion.
+        after: f64,
+    },
+}
+
+impl std::fmt::Display for Fallback {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Fallback::CycleTime { before, after } => write!(
+                f,
+                "the best order found would take {after:.1} s against the input's {before:.1} s, so the input order is kept"
+            ),
+            Fallback::Cost { kind, before, after } => write!(
+                f,
+                "the best order found costs {after:.1} {} of off-part motion against the input's {before:.1}, so the input order is kept",
+                kind.unit()
+            ),
+        }
+    }
+}
+
 /// Writes the program for a route found by any solver over `afp.problem` and verifies it
-/// against the original: the way to run another sequencing algorithm (seed 000's, for one) on
+/// against the original: the way to run another sequencing algorithm (Doherty et al.'s, for one) on
 /// the same parts. The steps are checked against the problem first.
 pub fn apply_steps(
     program: &Program,

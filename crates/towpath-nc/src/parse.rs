@@ -10,7 +10,7 @@ use crate::dialect::{Codes, Dialect};
 use crate::error::NcError;
 use crate::interp::{Interp, Marker, Modal};
 use crate::lex::Lexed;
-use crate::program::{Course, Item, Ply, Program, Segment};
+use crate::program::{Course, Item, LineBreak, Ply, Program, Segment};
 
 /// What pass 1 learns of a line.
 #[derive(Clone, Debug, Default)]
@@ -21,12 +21,27 @@ struct LineFacts {
     residue: Option<String>,
 }
 
-/// Parses a program for a machine in a dialect.
+/// Parses a program for a machine in a dialect. Lines may end with LF, CRLF or (in a program
+/// without any LF) CR alone; a CR alone in the middle of a line of an LF or CRLF program (mixed
+/// line ends, which would silently join two lines) is refused, naming the line.
 pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program, NcError> {
-    let mut lines: Vec<String> = text.split('\n').map(str::to_string).collect();
-    let final_newline = text.ends_with('\n');
+    let breaks = if !text.contains('\n') && text.contains('\r') { LineBreak::Cr } else { LineBreak::Lf };
+    let sep = breaks.separator();
+    let mut lines: Vec<String> = text.split(sep).map(str::to_string).collect();
+    let final_newline = text.ends_with(sep);
     if final_newline {
         lines.pop();
+    }
+    if breaks == LineBreak::Lf {
+        for (i, l) in lines.iter().enumerate() {
+            if stray_cr(l.trim_end_matches('\r'), dialect) {
+                return Err(NcError::line(
+                    i + 1,
+                    "a carriage return (CR) in the middle of the line: the program mixes line ends (CR alone \
+                     and LF); give it one kind of line end (LF, CRLF or CR)",
+                ));
+            }
+        }
     }
     let codes = dialect.codes()?;
     let dim = machine.dim();
@@ -47,17 +62,18 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
         let a = it.apply(i, line).map_err(|e| match (e, open) {
             // Say which course: a line towpath cannot read inside one is often a course that
             // was never closed running into the footer.
-            (NcError::Line { line, message }, Some(o)) if message.ends_with(" inside a course") => {
+            (NcError::InCourse { line, message }, Some(o)) => {
                 let end = if has_contact { dialect.contact_off.as_str() } else { "last tow cut" };
                 NcError::Line {
                     line,
                     message: format!(
-                        "{} inside the course opened at line {} (if that course should have ended before, its {end} is missing)",
-                        message.trim_end_matches(" inside a course"),
+                        "{message}, inside the course opened at line {} (if that course should have ended before, its \
+                         {end} is missing)",
                         o + 1
                     ),
                 }
             }
+            (NcError::InCourse { line, message }, None) => NcError::Line { line, message },
             (e, _) => e,
         })?;
         let in_course = |contact: bool, mask: u64| if has_contact { contact } else { mask != 0 };
@@ -247,6 +263,25 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
         snaps[p].1.clone()
     };
 
+    // The dialect's switches on where each span starts.
+    let mut switches_on: Vec<Vec<crate::program::SwitchKey>> = vec![Vec::new(); k];
+    if !codes.switches.is_empty() {
+        let mut on: Vec<crate::program::SwitchKey> = Vec::new();
+        let mut c = 0;
+        for (j, line) in lines.iter().enumerate() {
+            while c < k && span_start[c] == j {
+                switches_on[c] = on.clone();
+                c += 1;
+            }
+            if let Some((key, is_on)) = crate::reverse::switch_of(line, dialect, &codes) {
+                on.retain(|x| *x != key);
+                if is_on {
+                    on.push(key);
+                    on.sort();
+                }
+            }
+        }
+    }
     let seg_index = |line: usize| segments.partition_point(|s| (s.line as usize) < line);
     let mut courses = Vec::with_capacity(k);
     for c in 0..k {
@@ -263,6 +298,7 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
             insert: snap(insert_at[c]),
             span_start: snap(span_start[c]),
             exit: snap(span_end[c]),
+            switches_on: std::mem::take(&mut switches_on[c]),
         });
     }
     Ok(Program {
@@ -270,6 +306,7 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
         end: snap(lines.len()),
         lines,
         final_newline,
+        breaks,
         dim,
         points,
         segments,
@@ -279,6 +316,24 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
         plies,
         footer_start,
     })
+}
+
+/// True if a CR stands between words of the line, outside comments (where it would join what
+/// was meant as two lines).
+fn stray_cr(line: &str, dialect: &Dialect) -> bool {
+    let Some(first) = line.find('\r') else { return false };
+    let mut in_parens = false;
+    for (i, c) in line.char_indices() {
+        match c {
+            '(' if dialect.comment_parens && !in_parens => in_parens = true,
+            ')' if in_parens => in_parens = false,
+            ';' if dialect.comment_semicolon && !in_parens => return false,
+            // Only trailing whitespace after it is harmless.
+            '\r' if !in_parens && i >= first && !line[i..].trim().is_empty() => return true,
+            _ => {}
+        }
+    }
+    false
 }
 
 /// The text of a motion line that is kept when its motion is regenerated: everything but the

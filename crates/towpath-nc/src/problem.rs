@@ -17,7 +17,7 @@ use crate::footprint::{footprints, Footprints, Width};
 use crate::interp::Interp;
 use crate::precedence::{course_precedence, precedence_sets};
 use crate::program::Program;
-use crate::reverse::{reversal_of, Reversed};
+use crate::reverse::{reversal_of, Irreversible, Reversed};
 
 /// Which precedence to impose.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
@@ -26,7 +26,7 @@ pub enum PrecedenceRule {
     /// A course after every course of an earlier ply it overlaps (default).
     #[default]
     Courses,
-    /// Seed 000's precedence sets: each set after the one before.
+    /// Doherty et al.'s precedence sets: each set after the one before.
     Sets,
     /// Every ply after the one before.
     Plies,
@@ -81,7 +81,24 @@ impl Default for AfpOptions {
     }
 }
 
+/// The cost to optimize when none is chosen: cycle time ([`CostKind::Time`], all axes
+/// together, a reversed course paying for its heading turn) when every axis of the machine has
+/// a velocity limit, else Doherty et al.'s weighted axis distance ([`CostKind::Axis`]).
+pub fn default_cost(machine: &Machine) -> CostKind {
+    if machine.axes_without_velocity().is_empty() {
+        CostKind::Time
+    } else {
+        CostKind::Axis
+    }
+}
+
 impl AfpOptions {
+    /// The default options for a machine: as [`AfpOptions::default`], with the cost
+    /// [`default_cost`] chooses.
+    pub fn for_machine(machine: &Machine) -> AfpOptions {
+        AfpOptions { cost: default_cost(machine), ..AfpOptions::default() }
+    }
+
     /// The width to use: the options', else the dialect's (course width first).
     pub fn width_or(&self, dialect: &Dialect) -> Option<Width> {
         self.width.or(dialect.course_width.map(Width::Course)).or(dialect.tow_width.map(Width::Tow))
@@ -93,7 +110,7 @@ impl AfpOptions {
 pub struct AfpProblem {
     /// The problem: task `c` is course `c`; mode 0 forward, mode 1 (if any) reverse.
     pub problem: Problem<MachineCost>,
-    /// Seed 000's precedence sets, in order, as lists of courses (each ply alone when there are
+    /// Doherty et al.'s precedence sets, in order, as lists of courses (each ply alone when there are
     /// no footprints).
     pub sets: Vec<Vec<usize>>,
     /// The plies of each set.
@@ -103,7 +120,7 @@ pub struct AfpProblem {
     /// How every course that has a reverse mode reverses (its lines are written when needed).
     pub reversed: Vec<Option<Reversed>>,
     /// Courses that could not be reversed, and why.
-    pub not_reversible: Vec<(usize, String)>,
+    pub not_reversible: Vec<(usize, Irreversible)>,
     /// The footprints, if computed.
     pub footprints: Option<Footprints>,
     /// Number of precedence edges given to the solver.
@@ -118,6 +135,7 @@ pub fn build_problem(
     opts: &AfpOptions,
 ) -> Result<AfpProblem, NcError> {
     let k = program.courses.len();
+    crate::reverse::check_switch_scope(program, dialect)?;
     let plies: Vec<Vec<usize>> = program.plies.iter().map(|p| p.courses.clone()).collect();
     let plies_with_courses = plies.iter().filter(|p| !p.is_empty()).count();
     let width = opts.width_or(dialect);
@@ -135,7 +153,7 @@ pub fn build_problem(
         _ => None,
     };
     let set_plies = match &fps {
-        Some(f) => precedence_sets(f, &plies),
+        Some(f) => precedence_sets(f, &plies)?,
         None => (0..plies.len()).map(|p| vec![p]).collect(),
     };
     let sets: Vec<Vec<usize>> =
@@ -146,7 +164,7 @@ pub fn build_problem(
     let mut not_reversible = Vec::new();
     if opts.bidirectional {
         use rayon::prelude::*;
-        let all: Vec<Result<Reversed, String>> =
+        let all: Vec<Result<Reversed, Irreversible>> =
             (0..k).into_par_iter().map(|c| reversal_of(program, c, machine, dialect)).collect();
         for (c, r) in all.into_iter().enumerate() {
             match r {
@@ -191,7 +209,7 @@ pub fn build_problem(
     match opts.precedence {
         PrecedenceRule::Courses => {
             if let Some(f) = &fps {
-                for (x, y) in course_precedence(f, &plies) {
+                for (x, y) in course_precedence(f, &plies)? {
                     b.precede(TaskId(x as u32), TaskId(y as u32));
                     edges += 1;
                 }

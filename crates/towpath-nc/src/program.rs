@@ -29,6 +29,10 @@ pub struct Segment {
     pub on_part: bool,
 }
 
+/// A switch of the dialect (its index among the dialect's switches) and the words written
+/// with its code (`M64 P3` and `M65 P3` are one switch, `M64 P4` another).
+pub type SwitchKey = (usize, Vec<(char, String)>);
+
 /// A line kept with a course outside its span: an original line, or text towpath kept from a
 /// transit line whose motion it regenerates (comments and words it does not understand).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -79,6 +83,9 @@ pub struct Course {
     pub span_start: Modal,
     /// The machine state after the span.
     pub exit: Modal,
+    /// The dialect's switches on where the span starts, reading the program in its order
+    /// (sorted; empty without switches in the dialect).
+    pub switches_on: Vec<SwitchKey>,
 }
 
 impl Course {
@@ -110,6 +117,25 @@ pub enum Region {
     Footer,
 }
 
+/// What separates the lines of a program.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LineBreak {
+    /// LF (a CRLF program keeps the CR at the end of each line).
+    Lf,
+    /// CR alone (a program with no LF at all).
+    Cr,
+}
+
+impl LineBreak {
+    /// The separator character.
+    pub fn separator(self) -> char {
+        match self {
+            LineBreak::Lf => '\n',
+            LineBreak::Cr => '\r',
+        }
+    }
+}
+
 /// A parsed program.
 #[derive(Clone, Debug)]
 pub struct Program {
@@ -117,6 +143,8 @@ pub struct Program {
     pub lines: Vec<String>,
     /// The source ended with a line terminator.
     pub final_newline: bool,
+    /// What separates the lines.
+    pub breaks: LineBreak,
     /// Number of machine axes.
     pub dim: usize,
     /// Physical axis values of every point the program reaches, `dim` values each.
@@ -181,7 +209,7 @@ impl Program {
 
     /// The source text of the whole program.
     pub fn text(&self) -> String {
-        join_lines(self.lines.iter().map(String::as_str), self.final_newline)
+        join_lines(self.lines.iter().map(String::as_str), self.final_newline, self.breaks)
     }
 
     /// Lines of a course's span that are laid (on-part segments), as segment indices.
@@ -209,19 +237,20 @@ pub fn ply_name(p: &Ply) -> String {
     }
 }
 
-/// Joins lines with `\n`, with a final `\n` if asked.
-pub(crate) fn join_lines<'a>(lines: impl Iterator<Item = &'a str>, final_newline: bool) -> String {
+/// Joins lines with the separator, with a final one if asked.
+pub(crate) fn join_lines<'a>(lines: impl Iterator<Item = &'a str>, final_newline: bool, breaks: LineBreak) -> String {
+    let sep = breaks.separator();
     let mut out = String::new();
     let mut first = true;
     for l in lines {
         if !first {
-            out.push('\n');
+            out.push(sep);
         }
         first = false;
         out.push_str(l);
     }
     if final_newline {
-        out.push('\n');
+        out.push(sep);
     }
     out
 }

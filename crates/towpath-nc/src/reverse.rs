@@ -44,21 +44,237 @@ struct Move {
 
 #[derive(Clone, Debug)]
 enum StationItem {
-    /// An original line kept as it is (comments, unknown words).
+    /// An original line kept as it is (comments, point codes, dwells).
     Line(String),
     /// An event line: the original text with its code word swapped.
     Event(String),
+    /// A switch line of the dialect: (switch and its words, on?, the line's text, its line).
+    Switch(SwitchKey, bool, String, usize),
+}
+
+use crate::program::SwitchKey;
+
+/// Why a course cannot be laid reversed (it is then laid forward only, and the report says why).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Irreversible {
+    /// A line of the course holds codes or words the dialect does not describe, between
+    /// contact and lift or around them: what they mean laid the other way is unknown.
+    #[error(
+        "line {line} holds {words}, which the dialect does not describe (declare it as a [[switch]] pair or in \
+         point_codes if it may be laid the other way)"
+    )]
+    Undescribed {
+        /// 1-based line.
+        line: usize,
+        /// The words, as written.
+        words: String,
+    },
+    /// A switch of the dialect is not turned on and then off within the course.
+    #[error("line {line}: {problem}")]
+    Switch {
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        problem: String,
+    },
+    /// The course holds an arc, sets positions, has codes outside its on-part block, or would
+    /// turn the heading beyond its limits.
+    #[error("{0}")]
+    Other(String),
 }
 
 /// Builds the reversed span of course `c`, or says why it cannot be reversed.
-pub fn reverse_course(program: &Program, c: usize, machine: &Machine, dialect: &Dialect) -> Result<Reversed, String> {
+pub fn reverse_course(
+    program: &Program,
+    c: usize,
+    machine: &Machine,
+    dialect: &Dialect,
+) -> Result<Reversed, Irreversible> {
     reverse_span(program, c, machine, dialect, true)
 }
 
 /// Like [`reverse_course`], but without writing the lines (`lines` is left empty): enough to
 /// know whether and how the course reverses.
-pub fn reversal_of(program: &Program, c: usize, machine: &Machine, dialect: &Dialect) -> Result<Reversed, String> {
+pub fn reversal_of(
+    program: &Program,
+    c: usize,
+    machine: &Machine,
+    dialect: &Dialect,
+) -> Result<Reversed, Irreversible> {
     reverse_span(program, c, machine, dialect, false)
+}
+
+/// What a line that neither moves nor has tow or contact codes is, for reversal.
+enum Still {
+    /// Changes modes only: the reversed moves carry their own modes.
+    Modes,
+    /// Kept at its point (comments, declared point codes, non-motion codes such as a dwell).
+    Point,
+    /// A switch of the dialect, on or off.
+    Switch(SwitchKey, bool),
+}
+
+/// Classifies a line that neither moves nor has tow or contact codes; `Err` holds the words
+/// the dialect does not describe.
+fn still_line(lexed: Option<&Lexed>, line: &str, codes: &crate::dialect::Codes, modal: bool) -> Result<Still, String> {
+    let Some(lexed) = lexed else { return Err(format!("{:?}", line.trim())) };
+    let g_known = |v: f64| {
+        codes
+            .rapid
+            .iter()
+            .chain(&codes.feed)
+            .chain(&codes.arc_cw)
+            .chain(&codes.arc_ccw)
+            .chain(&codes.planes)
+            .any(|c| c.matches('G', v))
+            || codes.absolute.matches('G', v)
+            || codes.incremental.matches('G', v)
+    };
+    let non_motion =
+        lexed.words.iter().any(|w| w.letter == 'G' && codes.non_motion.iter().any(|c| c.matches('G', w.value)));
+    let is_switch = |v: f64| codes.switches.iter().any(|(on, off)| on.matches('M', v) || off.matches('M', v));
+    // Words after a dwell, a point code or a switch code are their parameters.
+    let parameters = non_motion
+        || lexed
+            .words
+            .iter()
+            .any(|x| x.letter == 'M' && (codes.point.iter().any(|c| c.matches('M', x.value)) || is_switch(x.value)));
+    let mut switch: Option<(usize, bool, usize)> = None;
+    let mut unknown: Vec<String> = Vec::new();
+    for (k, w) in lexed.words.iter().enumerate() {
+        let text = line.get(w.span.clone()).unwrap_or("").to_string();
+        match w.letter {
+            'G' if g_known(w.value) || codes.non_motion.iter().any(|c| c.matches('G', w.value)) => {}
+            'M' if codes.point.iter().any(|c| c.matches('M', w.value)) => {}
+            'M' => match codes.switches.iter().enumerate().find_map(|(i, (on, off))| {
+                if on.matches('M', w.value) {
+                    Some((i, true))
+                } else if off.matches('M', w.value) {
+                    Some((i, false))
+                } else {
+                    None
+                }
+            }) {
+                Some((i, on)) if switch.is_none() => switch = Some((i, on, k)),
+                _ => unknown.push(text),
+            },
+            l if l == codes.line_number_word || l == codes.feed_word => {}
+            l if parameters && l != 'G' && l != 'M' => {}
+            _ => unknown.push(text),
+        }
+    }
+    if !unknown.is_empty() {
+        return Err(unknown.join(" "));
+    }
+    match switch {
+        Some((i, on, k)) => {
+            if modal || non_motion {
+                return Err(line.trim().to_string());
+            }
+            let words = lexed
+                .words
+                .iter()
+                .enumerate()
+                .filter(|&(x, w)| x != k && w.letter != codes.line_number_word)
+                .map(|(_, w)| (w.letter, w.text.to_string()))
+                .collect();
+            Ok(Still::Switch((i, words), on))
+        }
+        None if modal => Ok(Still::Modes),
+        None => Ok(Still::Point),
+    }
+}
+
+/// The switch a line turns on or off, with its words: a line with one switch code of the
+/// dialect (its other words, line number aside, name which switch). `None` for other lines.
+pub(crate) fn switch_of(line: &str, dialect: &Dialect, codes: &crate::dialect::Codes) -> Option<(SwitchKey, bool)> {
+    if codes.switches.is_empty() {
+        return None;
+    }
+    let lexed = crate::lex::lex(line.trim_end_matches('\r'), dialect.comment_parens, dialect.comment_semicolon).ok()?;
+    let mut found = None;
+    for (k, w) in lexed.words.iter().enumerate() {
+        if w.letter != 'M' {
+            continue;
+        }
+        if let Some(x) = codes.switches.iter().enumerate().find_map(|(i, (on, off))| {
+            (on.matches('M', w.value) || off.matches('M', w.value)).then_some((i, on.matches('M', w.value), k))
+        }) {
+            found = Some(x);
+        }
+    }
+    let (i, on, k) = found?;
+    let words = lexed
+        .words
+        .iter()
+        .enumerate()
+        .filter(|&(x, w)| x != k && w.letter != codes.line_number_word)
+        .map(|(_, w)| (w.letter, w.text.to_string()))
+        .collect();
+    Some(((i, words), on))
+}
+
+/// Checks that the courses may be laid in any order without changing which switches of the
+/// dialect are on where: every course, with the lines that travel with it, leaves each switch
+/// as it found it (a switch turned on before a course's approach is turned off again after its
+/// retract, before the next course; or it is left to the header and footer). Refused otherwise,
+/// naming the line that leaves a switch on (or off) for the courses after it.
+pub(crate) fn check_switch_scope(program: &Program, dialect: &Dialect) -> Result<(), crate::error::NcError> {
+    let codes = dialect.codes()?;
+    if codes.switches.is_empty() {
+        return Ok(());
+    }
+    let apply = |state: &mut Vec<SwitchKey>, text: &str| -> Option<bool> {
+        let (key, on) = switch_of(text, dialect, &codes)?;
+        let had = state.contains(&key);
+        state.retain(|k| *k != key);
+        if on {
+            state.push(key);
+        }
+        Some(had != on)
+    };
+    let mut base: Vec<SwitchKey> = Vec::new();
+    for line in &program.lines[..program.header_end] {
+        apply(&mut base, line);
+    }
+    base.sort();
+    for course in &program.courses {
+        let mut state = base.clone();
+        let mut last: Option<(usize, String)> = None;
+        let mut step = |j: usize, text: &str, state: &mut Vec<SwitchKey>| {
+            if apply(state, text).is_some() {
+                last = Some((j, text.trim_end_matches('\r').to_string()));
+            }
+        };
+        for item in course.pre_before.iter().chain(&course.pre_after) {
+            match item {
+                crate::program::Item::Line(j) => step(*j, &program.lines[*j], &mut state),
+                crate::program::Item::Kept(j, t) => step(*j, t, &mut state),
+            }
+        }
+        for j in course.span.clone() {
+            step(j, &program.lines[j], &mut state);
+        }
+        for item in &course.post {
+            match item {
+                crate::program::Item::Line(j) => step(*j, &program.lines[*j], &mut state),
+                crate::program::Item::Kept(j, t) => step(*j, t, &mut state),
+            }
+        }
+        state.sort();
+        if state != base {
+            let (j, text) = last.unwrap_or((course.span.start, String::new()));
+            return Err(crate::error::NcError::line(
+                j + 1,
+                format!(
+                    "{text:?} leaves a switch {on} for the courses after it: laid in another order, other courses \
+                     would run with it {on}; switch it back within the course (or in the header and footer)",
+                    on = if state.iter().any(|k| !base.contains(k)) { "on" } else { "off" },
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn reverse_span(
@@ -67,10 +283,11 @@ fn reverse_span(
     machine: &Machine,
     dialect: &Dialect,
     write: bool,
-) -> Result<Reversed, String> {
+) -> Result<Reversed, Irreversible> {
     let course = &program.courses[c];
-    let codes = dialect.codes().map_err(|e| e.to_string())?;
-    let mut it = Interp::new(dialect, machine).map_err(|e| e.to_string())?;
+    let other = |e: crate::error::NcError| Irreversible::Other(e.to_string());
+    let codes = dialect.codes().map_err(other)?;
+    let mut it = Interp::new(dialect, machine).map_err(other)?;
     it.m = course.span_start.clone();
     let dim = machine.dim();
 
@@ -81,7 +298,7 @@ fn reverse_span(
     let mut moves: Vec<Move> = Vec::new();
     for j in course.span.clone() {
         let line = program.lines[j].trim_end_matches('\r');
-        let a = it.apply(j, line).map_err(|e| e.to_string())?;
+        let a = it.apply(j, line).map_err(other)?;
         let part = if j < course.on_part.start {
             Part::Approach
         } else if j < course.on_part.end {
@@ -90,20 +307,27 @@ fn reverse_span(
             Part::Retract
         };
         if a.set_position {
-            return Err(format!("line {} sets positions inside the course", j + 1));
+            return Err(Irreversible::Other(format!("line {} sets positions inside the course", j + 1)));
         }
         if a.events && part != Part::On {
             // Outside the on-part block such a code changes nothing (the roller is already
             // lifted, no tow is on); swapped, it would.
-            return Err(format!("line {} has tow or contact codes outside the on-part block", j + 1));
+            return Err(Irreversible::Other(format!(
+                "line {} has tow or contact codes outside the on-part block",
+                j + 1
+            )));
         }
         let lexed = a.lexed.clone().unwrap_or_default();
+        let undescribed = |words: String| Irreversible::Undescribed { line: j + 1, words };
         if let Some(rapid) = a.motion {
             if a.arc {
-                return Err(format!("line {} is an arc: towpath lays arcs only as they are written, forward", j + 1));
+                return Err(Irreversible::Other(format!(
+                    "line {} is an arc: towpath lays arcs only as they are written, forward",
+                    j + 1
+                )));
             }
             if a.unknown {
-                return Err(format!("line {} has words towpath does not know on a move", j + 1));
+                return Err(undescribed(unknown_words(&lexed, line, &codes, &it)));
             }
             let event_text = |evs: &[Event]| -> Vec<StationItem> {
                 evs.iter().map(|e| StationItem::Event(swapped_event(e, dialect, &lexed))).collect()
@@ -122,24 +346,41 @@ fn reverse_span(
             stations.push(event_text(&a.after));
         } else if a.events {
             if a.modal {
-                return Err(format!("line {} mixes mode changes and tow or contact codes", j + 1));
+                return Err(Irreversible::Other(format!("line {} mixes mode changes and tow or contact codes", j + 1)));
+            }
+            if a.unknown {
+                return Err(undescribed(unknown_words(&lexed, line, &codes, &it)));
             }
             let evs: Vec<Event> = a.events().copied().collect();
             if evs.len() != 1 {
-                return Err(format!("line {} has several tow or contact codes", j + 1));
+                return Err(Irreversible::Other(format!("line {} has several tow or contact codes", j + 1)));
             }
             let item = StationItem::Event(swap_line_code(line, &evs[0], dialect, &codes, &lexed));
             if let Some(s) = stations.last_mut() {
                 s.push(item);
             }
-        } else if a.modal {
-            if a.unknown {
-                return Err(format!("line {} mixes mode changes with words towpath does not know", j + 1));
-            }
-            // A pure mode change: the reversed moves carry their own modes.
         } else {
-            if let Some(s) = stations.last_mut() {
-                s.push(StationItem::Line(line.to_string()));
+            let item = match still_line(a.lexed.as_ref(), line, &codes, a.modal).map_err(undescribed)? {
+                // A pure mode change: the reversed moves carry their own modes.
+                Still::Modes => None,
+                Still::Point => Some(StationItem::Line(line.to_string())),
+                Still::Switch(key, on) => Some(StationItem::Switch(key, on, line.to_string(), j)),
+            };
+            if let (Some(s), Some(item)) = (stations.last_mut(), item) {
+                s.push(item);
+            }
+        }
+    }
+    pair_switches(&mut stations)?;
+    // A switch already on where the course starts and switched within it would not be on along
+    // the same stretch reversed (its on and off lines trade places assuming it starts off).
+    for item in stations.iter().flatten() {
+        if let StationItem::Switch(key, _, text, j) = item {
+            if course.switches_on.contains(key) {
+                return Err(Irreversible::Switch {
+                    line: j + 1,
+                    problem: format!("{:?} switches what is already on where the course starts", text.trim()),
+                });
             }
         }
     }
@@ -159,7 +400,10 @@ fn reverse_span(
                 } else if fits(-180.0) {
                     -180.0
                 } else {
-                    return Err(format!("turning the heading axis {} by 180° leaves its travel limits", ax.label));
+                    return Err(Irreversible::Other(format!(
+                        "turning the heading axis {} by 180° leaves its travel limits",
+                        ax.label
+                    )));
                 }
             }
             _ => {
@@ -202,7 +446,7 @@ fn reverse_span(
     for s in (0..stations_to_write).rev() {
         for item in stations[s].iter().rev() {
             match item {
-                StationItem::Line(t) | StationItem::Event(t) => lines.push(t.clone()),
+                StationItem::Line(t) | StationItem::Event(t) | StationItem::Switch(_, _, t, _) => lines.push(t.clone()),
             }
         }
         if s == 0 {
@@ -261,6 +505,97 @@ fn reverse_span(
     entry.contact = false;
     entry.mask = 0;
     Ok(Reversed { lines, entry, shift })
+}
+
+/// The words of a line the dialect does not describe (or the whole line if it cannot be read).
+fn unknown_words(lexed: &Lexed, line: &str, codes: &crate::dialect::Codes, it: &Interp) -> String {
+    let known = |w: &crate::lex::Word| {
+        let (l, v) = (w.letter, w.value);
+        (l == 'G'
+            && ((codes
+                .rapid
+                .iter()
+                .chain(&codes.feed)
+                .chain(&codes.arc_cw)
+                .chain(&codes.arc_ccw)
+                .chain(&codes.planes))
+            .any(|c| c.matches(l, v))
+                || codes.absolute.matches(l, v)
+                || codes.incremental.matches(l, v)))
+            || (l == 'M'
+                && (codes.restart.matches(l, v)
+                    || codes.cut.matches(l, v)
+                    || codes.contact.is_some_and(|(on, off)| on.matches(l, v) || off.matches(l, v))))
+            || l == codes.feed_word
+            || l == codes.line_number_word
+            || l == codes.mask_word
+            || it.axis_of(l).is_some()
+    };
+    let words: Vec<&str> = lexed.words.iter().filter(|w| !known(w)).filter_map(|w| line.get(w.span.clone())).collect();
+    if words.is_empty() {
+        format!("{:?}", line.trim())
+    } else {
+        words.join(" ")
+    }
+}
+
+/// Pairs each switch's on and off lines within the span (they must alternate, on first, and end
+/// off) and swaps their texts: reversed, the on line is written where the off line was and
+/// the other way round, so the same stretch of the path runs with the switch on.
+fn pair_switches(stations: &mut [Vec<StationItem>]) -> Result<(), Irreversible> {
+    // (key, position of its open on line)
+    let mut open: Vec<(SwitchKey, (usize, usize))> = Vec::new();
+    let mut pairs: Vec<((usize, usize), (usize, usize))> = Vec::new();
+    for (si, items) in stations.iter().enumerate() {
+        for (ii, item) in items.iter().enumerate() {
+            let StationItem::Switch(key, on, text, j) = item else { continue };
+            let at = open.iter().position(|(k, _)| k == key);
+            match (on, at) {
+                (true, None) => open.push((key.clone(), (si, ii))),
+                (false, Some(x)) => {
+                    let (_, from) = open.remove(x);
+                    pairs.push((from, (si, ii)));
+                }
+                (true, Some(_)) => {
+                    return Err(Irreversible::Switch {
+                        line: j + 1,
+                        problem: format!("{:?} switches on what is already on within the course", text.trim()),
+                    })
+                }
+                (false, None) => {
+                    return Err(Irreversible::Switch {
+                        line: j + 1,
+                        problem: format!(
+                            "{:?} switches off what the course did not switch on (it was on before the course)",
+                            text.trim()
+                        ),
+                    })
+                }
+            }
+        }
+    }
+    if let Some((_, (si, ii))) = open.first() {
+        if let Some(StationItem::Switch(_, _, text, j)) = stations.get(*si).and_then(|s| s.get(*ii)) {
+            return Err(Irreversible::Switch {
+                line: j + 1,
+                problem: format!("{:?} switches on and the course does not switch it off again", text.trim()),
+            });
+        }
+    }
+    for ((s0, i0), (s1, i1)) in pairs {
+        let t0 = match &stations[s0][i0] {
+            StationItem::Switch(_, _, t, _) => t.clone(),
+            _ => continue,
+        };
+        let t1 = match &mut stations[s1][i1] {
+            StationItem::Switch(_, _, t, _) => std::mem::replace(t, t0),
+            _ => continue,
+        };
+        if let StationItem::Switch(_, _, t, _) = &mut stations[s0][i0] {
+            *t = t1;
+        }
+    }
+    Ok(())
 }
 
 /// The text of an event split off a motion line: the swapped code and, for tows, the mask.

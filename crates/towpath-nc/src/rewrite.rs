@@ -165,7 +165,7 @@ pub fn rewrite(
     for j in program.footer_start..program.lines.len() {
         e.original(program, j)?;
     }
-    Ok(join_lines(e.out.iter().map(String::as_str), program.final_newline))
+    Ok(join_lines(e.out.iter().map(String::as_str), program.final_newline, program.breaks))
 }
 
 struct Emitter<'a> {

@@ -1,7 +1,7 @@
-//! Which solver sequences the courses: towpath's own, or one of the seed papers' algorithms
+//! Which solver sequences the courses: towpath's own, or one of the published algorithms towpath is built from
 //! from `towpath-baselines`, on the same problem.
 //!
-//! Seed 000's solver (`doherty`) works per precedence set: it gets the program's seed-000 sets
+//! Doherty et al.'s solver (`doherty`) works per precedence set: it gets the program's Doherty et al.'s precedence sets
 //! ([`seed000_sets`]) unless the caller gave its own. Every solver starts from the original
 //! order (`SolveOptions::initial`) and returns it when it finds nothing cheaper.
 
@@ -12,22 +12,22 @@ use crate::error::NcError;
 use crate::problem::{AfpOptions, AfpProblem, PrecedenceRule};
 use crate::program::Program;
 
-/// The precedence sets seed 000's solver orders one after another, for the problem built under
+/// The precedence sets Doherty et al.'s solver orders one after another, for the problem built under
 /// `opts`:
 ///
-/// - course-level precedence (`courses`) and seed 000's own (`sets`): the seed-000 sets of the
+/// - course-level precedence (`courses`) and Doherty et al.'s own (`sets`): the Doherty et al.'s precedence sets of the
 ///   program ([`AfpProblem::sets`]), each with the count of its plies that hold courses; every
 ///   course-level precedence rule goes from an earlier set to a later one, because plies are
 ///   only joined into a set while they do not intersect;
-/// - ply by ply (`plies`): one set per ply, since plies joined into a seed-000 set must then
+/// - ply by ply (`plies`): one set per ply, since plies joined into one of Doherty et al.'s sets must then
 ///   still be laid in order.
 ///
-/// Keeping the order of the courses within each ply is not part of seed 000's model (its
+/// Keeping the order of the courses within each ply is not part of Doherty et al.'s model (its
 /// solver orders each set freely), so it is refused.
 pub fn seed000_sets(program: &Program, afp: &AfpProblem, opts: &AfpOptions) -> Result<Vec<PrecedenceSet>, NcError> {
     if opts.keep_ply_order {
         return Err(NcError::Solver(
-            "doherty cannot keep the order of the courses within each ply: seed 000's solver orders every \
+            "doherty cannot keep the order of the courses within each ply: Doherty et al.'s solver orders every \
              precedence set freely (drop --keep-ply-order, or use another solver)"
                 .into(),
         ));
@@ -56,7 +56,7 @@ pub fn seed000_sets(program: &Program, afp: &AfpProblem, opts: &AfpOptions) -> R
 }
 
 /// Runs `solver` on the program's problem from the original order. For `doherty` without sets
-/// in `params`, the program's seed-000 sets are used ([`seed000_sets`]).
+/// in `params`, the program's Doherty et al.'s precedence sets are used ([`seed000_sets`]).
 pub fn sequence(
     solver: SolverName,
     params: &BaselineParams,

@@ -19,9 +19,9 @@ use towpath_machine::{CostKind, Machine, MachineCost, StateTable};
 use crate::dialect::Dialect;
 use crate::error::NcError;
 use crate::footprint::{footprints, Footprints, Width};
-use crate::lex::lex;
-use crate::program::{Item, Program, Region};
+use crate::program::{Program, Region};
 use crate::rewrite::Placement;
+use crate::width::WidthUsed;
 
 /// What the verifier checks beyond the course rule.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -32,7 +32,7 @@ pub struct VerifyOptions {
     pub strict_plies: bool,
     /// Also require the courses of each ply in their original order.
     pub keep_ply_order: bool,
-    /// Also require seed 000's precedence sets in order: every course of a set laid before any
+    /// Also require Doherty et al.'s precedence sets in order: every course of a set laid before any
     /// course of the next (the verifier finds the sets on its own, from the footprints).
     pub seed000_sets: bool,
 }
@@ -68,6 +68,20 @@ pub enum VerifyError {
     /// A course of the original is not laid.
     #[error("{0} of the original is not laid by the optimized program")]
     Missing(String),
+    /// A line of the optimized program is none of the original's lines, nor part of a legal
+    /// reversal, nor a transit towpath writes.
+    #[error(
+        "optimized program line {line} ({text:?}) {place} is not a line of the original, of a legal reversal, or of \
+         a transit towpath writes"
+    )]
+    ExtraLine {
+        /// 1-based line in the optimized program.
+        line: usize,
+        /// Its text.
+        text: String,
+        /// Where it is.
+        place: String,
+    },
     /// A line the original keeps is gone.
     #[error("original line {line} ({text:?}) is missing from the optimized program")]
     LostLine {
@@ -125,6 +139,11 @@ pub struct Verification {
     pub order: Vec<Placement>,
     /// True if precedence between plies was checked on footprints.
     pub precedence_checked: bool,
+    /// True if every ply was checked to be finished before the next starts (which implies
+    /// precedence between plies without footprints).
+    pub ply_order_checked: bool,
+    /// The course width of the footprints and where it came from.
+    pub width: WidthUsed,
     /// Motion of the original, per cost model.
     pub before: Vec<Motion>,
     /// Motion of the optimized program, per cost model (courses indexed as in the original).
@@ -167,9 +186,22 @@ pub fn verify_parsed(
         return Err(VerifyError::CourseCount { got: opt.courses.len(), expected: k });
     }
     let tol = (0.5 * 10f64.powi(-(dialect.decimals as i32))).max(1e-6);
-    check_header_footer(orig, opt)?;
-    let (order, rewritten) = match_courses(orig, opt, machine, tol)?;
-    check_kept_lines(orig, opt, &order, &rewritten, dialect)?;
+    crate::verify_lines::check_header_footer(orig, opt)?;
+    let order = match_courses(orig, opt, machine, dialect, tol)?;
+    // The moves of each course (reversed, the original's retract leads), for its lines.
+    let windows: Vec<Option<std::ops::Range<usize>>> = order
+        .iter()
+        .enumerate()
+        .map(|(kc, p)| {
+            let a = span_motion(orig, p.course);
+            if p.reversed {
+                window_range(opt, kc, a.trail, a.lead)
+            } else {
+                window_range(opt, kc, a.lead, a.trail)
+            }
+        })
+        .collect();
+    crate::verify_lines::account(orig, opt, &order, &windows, dialect, machine)?;
 
     // Precedence.
     let plies_with_courses = orig.plies.iter().filter(|p| !p.courses.is_empty()).count();
@@ -178,8 +210,11 @@ pub fn verify_parsed(
     for (i, p) in order.iter().enumerate() {
         pos[p.course] = i;
     }
-    if plies_with_courses > 1 {
-        let width = opts.width.or(dialect.course_width.map(Width::Course)).or(dialect.tow_width.map(Width::Tow));
+    let width_used = WidthUsed::choose(opts.width, dialect, orig);
+    // Ply after ply implies the course rule; without a width that is all there is to check.
+    let by_ply_order_alone = opts.strict_plies && fps.is_none() && width_used.width.is_none();
+    if plies_with_courses > 1 && !by_ply_order_alone {
+        let width = width_used.width;
         let owned;
         let fps = match (fps, width) {
             (Some(f), _) => f,
@@ -190,7 +225,8 @@ pub fn verify_parsed(
             (None, None) => {
                 return Err(VerifyError::Setup(NcError::Width(
                     "checking precedence between plies needs course footprints: give --tow-width MM or \
-                     --course-width MM (or tow_width / course_width in the dialect)"
+                     --course-width MM (or tow_width / course_width in the dialect), or check ply by ply \
+                     (--precedence plies), which needs none"
                         .into(),
                 )))
             }
@@ -241,6 +277,8 @@ pub fn verify_parsed(
         reversed: order.iter().filter(|p| p.reversed).count(),
         order,
         precedence_checked,
+        ply_order_checked: opts.strict_plies,
+        width: width_used,
         before,
         after,
     })
@@ -313,12 +351,15 @@ fn span_motion(p: &Program, c: usize) -> SpanMotion {
 /// transit, or the next course's approach, reads as part of it; such moves are off-part all the
 /// same.) `None` if the program has not that many moves there.
 fn window(p: &Program, kc: usize, lead: usize, trail: usize) -> Option<SpanMotion> {
+    let range = window_range(p, kc, lead, trail)?;
+    Some(motion_of(p, range, lead, trail))
+}
+
+/// The segment indices of [`window`].
+fn window_range(p: &Program, kc: usize, lead: usize, trail: usize) -> Option<std::ops::Range<usize>> {
     let laid = laying(p, kc);
     let (lo, hi) = (laid.start.checked_sub(lead)?, laid.end + trail);
-    if hi > p.segments.len() {
-        return None;
-    }
-    Some(motion_of(p, lo..hi, lead, trail))
+    (hi <= p.segments.len()).then_some(lo..hi)
 }
 
 /// The point where a course starts laying (forward) or ends laying, for finding candidates
@@ -391,7 +432,15 @@ fn reversed_feeds(p: &Program, c: usize) -> Vec<f64> {
 }
 
 /// Checks that optimized course `kc` is original course `oc` legally reversed.
-fn is_reversal(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Machine, tol: f64) -> Result<(), String> {
+fn is_reversal(
+    orig: &Program,
+    oc: usize,
+    opt: &Program,
+    kc: usize,
+    machine: &Machine,
+    dialect: &Dialect,
+    tol: f64,
+) -> Result<(), String> {
     let a = span_motion(orig, oc);
     // Reversed, the original's retract leads and its approach trails.
     let Some(b) = window(opt, kc, a.trail, a.lead) else {
@@ -443,7 +492,8 @@ fn is_reversal(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Ma
             ));
         }
     }
-    Ok(())
+    let range = window_range(opt, kc, a.trail, a.lead).unwrap_or(0..0);
+    crate::verify_lines::rewritten_lines(orig, oc, opt, kc, range, true, dialect, machine)
 }
 
 fn same_value(machine: &Machine, i: usize, a: f64, b: f64, turn: f64, tol: f64) -> bool {
@@ -517,8 +567,9 @@ fn match_courses(
     orig: &Program,
     opt: &Program,
     machine: &Machine,
+    dialect: &Dialect,
     tol: f64,
-) -> Result<(Vec<Placement>, Vec<bool>), VerifyError> {
+) -> Result<Vec<Placement>, VerifyError> {
     let k = orig.courses.len();
     let mut by_text: HashMap<String, Vec<usize>> = HashMap::new();
     for c in (0..k).rev() {
@@ -599,7 +650,7 @@ fn match_courses(
             if !take(oc) || out.iter().any(|x| x.0.course == oc) {
                 continue;
             }
-            match is_reversal(orig, oc, opt, kc, machine, tol) {
+            match is_reversal(orig, oc, opt, kc, machine, dialect, tol) {
                 Ok(()) => {
                     out.push((Placement { course: oc, reversed: true }, false));
                     if done(&out) {
@@ -642,18 +693,18 @@ fn match_courses(
         }
     }
     let mut order = Vec::with_capacity(k);
-    let mut rewritten = Vec::with_capacity(k);
+
     for c in chosen {
         let Some((p, text)) = c else {
             return Err(VerifyError::Missing(String::from("a course")));
         };
         order.push(p);
-        rewritten.push(!text);
+        let _ = text;
     }
     if let Some(c) = owner.iter().position(Option::is_none) {
         return Err(VerifyError::Missing(orig.course_name(c)));
     }
-    Ok((order, rewritten))
+    Ok(order)
 }
 
 /// Kuhn's augmenting path: gives optimized course `kc` one of its candidates, moving the
@@ -687,194 +738,160 @@ where
     false
 }
 
-/// A line that must survive: not a move, and no tow, contact or mode codes (those are checked
-/// through the motion).
-fn must_keep(line: &str, dialect: &Dialect) -> bool {
-    let Ok(l) = lex(line, dialect.comment_parens, dialect.comment_semicolon) else {
-        return !line.trim().is_empty();
-    };
-    let codes = [&dialect.contact_on, &dialect.contact_off, &dialect.tow_restart, &dialect.tow_cut];
-    let modal_or_event = l.words.iter().any(|w| {
-        w.letter == 'G'
-            || w.letter.to_string().eq_ignore_ascii_case(&dialect.feed_word)
-            || codes.iter().any(|c| crate::dialect::Code::parse(c).is_some_and(|c| c.matches(w.letter, w.value)))
-    });
-    let blank = l.words.is_empty() && l.comments.is_empty();
-    !modal_or_event && !blank
+/// Most (rectangle, cell) incidences the verifier's grids hold; their cells grow until the
+/// footprints touch no more.
+const MAX_GRID_HITS: u64 = 8_000_000;
+
+/// Most grid entries the verifier's precedence checks compare before giving up.
+const MAX_GRID_VISITS: u64 = 1_000_000_000;
+
+/// The verifier's grid over the footprint frame: square cells of about eight median half
+/// widths (larger if the footprints would touch too many), periodic rows on a mandrel.
+struct CellGrid {
+    cell: f64,
+    hcell: f64,
+    rows: Option<i64>,
 }
 
-fn check_kept_lines(
-    orig: &Program,
-    opt: &Program,
-    order: &[Placement],
-    rewritten: &[bool],
-    dialect: &Dialect,
-) -> Result<(), VerifyError> {
-    let mut have: HashMap<&str, usize> = HashMap::new();
-    for l in &opt.lines {
-        *have.entry(l.trim_end_matches('\r')).or_default() += 1;
-    }
-    let mut need: Vec<(usize, String)> = Vec::new();
-    // Text kept from transit lines: on a line of its own, or, where the transit itself was
-    // kept (the original order), on the original line.
-    let mut kept: Vec<(usize, &str)> = Vec::new();
-    for j in (0..orig.header_end).chain(orig.footer_start..orig.lines.len()) {
-        need.push((j, orig.lines[j].clone()));
-    }
-    for course in &orig.courses {
-        for item in course.pre_before.iter().chain(&course.pre_after).chain(&course.post) {
-            match item {
-                Item::Line(j) => need.push((*j, orig.lines[*j].clone())),
-                Item::Kept(j, t) => kept.push((*j, t)),
-            }
-        }
-    }
-    for (p, _) in order.iter().zip(rewritten).filter(|(_, r)| **r) {
-        for j in orig.courses[p.course].span.clone() {
-            if orig.line_segment[j].is_none() && must_keep(&orig.lines[j], dialect) {
-                need.push((j, orig.lines[j].clone()));
-            }
-        }
-    }
-    for (j, text) in need {
-        let t = text.trim_end_matches('\r');
-        match have.get_mut(t) {
-            Some(n) if *n > 0 => *n -= 1,
-            _ => return Err(VerifyError::LostLine { line: j + 1, text: t.to_string() }),
-        }
-    }
-    for (j, t) in kept {
-        let whole = orig.lines[j].trim_end_matches('\r');
-        let found = [whole, t].into_iter().any(|x| match have.get_mut(x) {
-            Some(n) if *n > 0 => {
-                *n -= 1;
-                true
-            }
-            _ => false,
-        });
-        if !found {
-            return Err(VerifyError::LostLine { line: j + 1, text: t.to_string() });
-        }
-    }
-    Ok(())
-}
-
-/// The header and the footer must be there, line for line, at the start and the end.
-fn check_header_footer(orig: &Program, opt: &Program) -> Result<(), VerifyError> {
-    let same = |a: &str, b: &str| a.trim_end_matches('\r') == b.trim_end_matches('\r');
-    for j in 0..orig.header_end {
-        if !opt.lines.get(j).is_some_and(|l| same(l, &orig.lines[j])) {
-            return Err(VerifyError::LostLine { line: j + 1, text: orig.lines[j].clone() });
-        }
-    }
-    let footer_len = orig.lines.len() - orig.footer_start;
-    if opt.lines.len() < footer_len + orig.header_end {
-        let j = orig.footer_start.min(orig.lines.len().saturating_sub(1));
-        return Err(VerifyError::LostLine { line: j + 1, text: orig.lines.get(j).cloned().unwrap_or_default() });
-    }
-    let off = opt.lines.len() - footer_len;
-    for j in 0..footer_len {
-        if !same(&opt.lines[off + j], &orig.lines[orig.footer_start + j]) {
-            let line = orig.footer_start + j;
-            return Err(VerifyError::LostLine { line: line + 1, text: orig.lines[line].clone() });
-        }
-    }
-    Ok(())
-}
-
-/// Sweeps the courses in their new order over a grid of the courses laid so far: a course
-/// laid before an overlapping course of an earlier ply is a violation.
-fn check_precedence(orig: &Program, fps: &Footprints, order: &[Placement]) -> Result<(), VerifyError> {
-    let mut widths: Vec<f64> = fps.courses.iter().flat_map(|f| f.quads.iter().map(|q| q.hw)).collect();
-    widths.sort_by(f64::total_cmp);
-    let cell = widths.get(widths.len() / 2).map_or(10.0, |w| (8.0 * w).max(1e-2));
-    let period = fps.frame.period();
-    let rows = period.map(|p| ((p / cell).ceil().max(1.0)) as i64);
-    let hcell = match (period, rows) {
-        (Some(p), Some(r)) => p / r as f64,
-        _ => cell,
-    };
-    // cell -> (max ply laid, entries (course, quad))
-    type Cell = (usize, Vec<(u32, u32)>);
-    let mut grid: HashMap<(i64, i64), Cell> = HashMap::new();
-    let key = |i: i64, j: i64| match rows {
-        Some(r) => (i, j.rem_euclid(r)),
-        None => (i, j),
-    };
-    for p in order {
-        let b = p.course;
-        let pb = orig.courses[b].ply;
-        for (qi, q) in fps.courses[b].quads.iter().enumerate() {
-            let (lo, hi) = q.bounds();
-            let (i0, i1) = ((lo[0] / cell).floor() as i64, (hi[0] / cell).floor() as i64);
-            let (j0, j1) = ((lo[1] / hcell).floor() as i64, (hi[1] / hcell).floor() as i64);
-            for i in i0..=i1 {
-                for j in j0..=j1 {
-                    let entry = grid.entry(key(i, j)).or_insert((0, Vec::new()));
-                    if entry.0 > pb {
-                        for &(x, qx) in &entry.1 {
-                            let px = orig.courses[x as usize].ply;
-                            if px > pb
-                                && crate::precedence::quads_overlap(
-                                    &fps.frame,
-                                    q,
-                                    &fps.courses[x as usize].quads[qx as usize],
-                                )
-                            {
-                                return Err(VerifyError::Precedence {
-                                    before: orig.course_name(b),
-                                    after: orig.course_name(x as usize),
-                                });
-                            }
-                        }
-                    }
-                    entry.0 = entry.0.max(pb);
-                    entry.1.push((b as u32, qi as u32));
+impl CellGrid {
+    fn new(fps: &Footprints) -> Self {
+        let mut widths: Vec<f64> = fps.courses.iter().flat_map(|f| f.quads.iter().map(|q| q.hw)).collect();
+        widths.sort_by(f64::total_cmp);
+        let mut cell = widths.get(widths.len() / 2).map_or(10.0, |w| (8.0 * w).max(1e-2));
+        loop {
+            let g = CellGrid::sized(fps, cell);
+            let mut hits = 0u64;
+            for q in fps.courses.iter().flat_map(|f| f.quads.iter()) {
+                let (i, j) = g.ranges(q);
+                let n = (i.1 - i.0 + 1).max(1) as f64 * (j.1 - j.0 + 1).max(1) as f64;
+                hits = hits.saturating_add(n.min(1e18) as u64);
+                if hits > MAX_GRID_HITS {
+                    break;
                 }
             }
+            if hits <= MAX_GRID_HITS || !cell.is_finite() {
+                return g;
+            }
+            cell *= 2.0;
         }
     }
-    Ok(())
-}
 
-/// Seed 000's precedence sets, found here on their own: the plies in program order, each
-/// joining the current set unless one of its courses overlaps a course already in it, else
-/// starting the next set. Returns the set of each course (sets numbered from 0).
-fn sets_of_courses(plies: &[Vec<usize>], fps: &Footprints) -> Vec<usize> {
-    let mut widths: Vec<f64> = fps.courses.iter().flat_map(|f| f.quads.iter().map(|q| q.hw)).collect();
-    widths.sort_by(f64::total_cmp);
-    let cell = widths.get(widths.len() / 2).map_or(10.0, |w| (8.0 * w).max(1e-2));
-    let rows = fps.frame.period().map(|p| ((p / cell).ceil().max(1.0)) as i64);
-    let hcell = match (fps.frame.period(), rows) {
-        (Some(p), Some(r)) => p / r as f64,
-        _ => cell,
-    };
-    let cells_of = |q: &crate::footprint::Quad| {
+    fn sized(fps: &Footprints, cell: f64) -> Self {
+        let period = fps.frame.period();
+        let rows = period.map(|p| ((p / cell).ceil().max(1.0)) as i64);
+        let hcell = match (period, rows) {
+            (Some(p), Some(r)) => p / r as f64,
+            _ => cell,
+        };
+        CellGrid { cell, hcell, rows }
+    }
+
+    /// The column and row ranges a rectangle's bounds cover.
+    fn ranges(&self, q: &crate::footprint::Quad) -> ((i64, i64), (i64, i64)) {
         let (lo, hi) = q.bounds();
-        let (i0, i1) = ((lo[0] / cell).floor() as i64, (hi[0] / cell).floor() as i64);
-        let (j0, j1) = ((lo[1] / hcell).floor() as i64, (hi[1] / hcell).floor() as i64);
+        (
+            ((lo[0] / self.cell).floor() as i64, (hi[0] / self.cell).floor() as i64),
+            ((lo[1] / self.hcell).floor() as i64, (hi[1] / self.hcell).floor() as i64),
+        )
+    }
+
+    /// The keys of the cells a rectangle's bounds cover (rows wrapped on a mandrel).
+    fn keys(&self, q: &crate::footprint::Quad) -> impl Iterator<Item = (i64, i64)> + '_ {
+        let ((i0, i1), (j0, j1)) = self.ranges(q);
+        let rows = self.rows;
         (i0..=i1).flat_map(move |i| {
             (j0..=j1).map(move |j| match rows {
                 Some(r) => (i, j.rem_euclid(r)),
                 None => (i, j),
             })
         })
-    };
+    }
+}
+
+/// The error of a check that compared more than [`MAX_GRID_VISITS`] grid entries.
+fn too_dense(what: &str) -> VerifyError {
+    VerifyError::Setup(NcError::WorkLimit {
+        what: what.into(),
+        limit: MAX_GRID_VISITS,
+        unit: "footprint comparisons".into(),
+        advice: "the courses' footprints are piled up far more densely than on any real part; check the program and \
+                 the course width"
+            .into(),
+    })
+}
+
+/// Sweeps the courses in their new order over a grid of the courses laid so far: a course
+/// laid before an overlapping course of an earlier ply is a violation.
+fn check_precedence(orig: &Program, fps: &Footprints, order: &[Placement]) -> Result<(), VerifyError> {
+    let g = CellGrid::new(fps);
+    // cell -> (max ply laid, entries (course, quad))
+    type Cell = (usize, Vec<(u32, u32)>);
+    let mut grid: HashMap<(i64, i64), Cell> = HashMap::new();
+    let mut visits = 0u64;
+    for p in order {
+        let b = p.course;
+        let pb = orig.courses[b].ply;
+        for (qi, q) in fps.courses[b].quads.iter().enumerate() {
+            for key in g.keys(q) {
+                let entry = grid.entry(key).or_insert((0, Vec::new()));
+                if entry.0 > pb {
+                    visits += entry.1.len() as u64;
+                    if visits > MAX_GRID_VISITS {
+                        return Err(too_dense("checking precedence"));
+                    }
+                    for &(x, qx) in &entry.1 {
+                        let px = orig.courses[x as usize].ply;
+                        if px > pb
+                            && crate::precedence::quads_overlap(
+                                &fps.frame,
+                                q,
+                                &fps.courses[x as usize].quads[qx as usize],
+                            )
+                        {
+                            return Err(VerifyError::Precedence {
+                                before: orig.course_name(b),
+                                after: orig.course_name(x as usize),
+                            });
+                        }
+                    }
+                }
+                entry.0 = entry.0.max(pb);
+                entry.1.push((b as u32, qi as u32));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Doherty et al.'s precedence sets, found here on their own: the plies in program order, each
+/// joining the current set unless one of its courses overlaps a course already in it, else
+/// starting the next set. Returns the set of each course (sets numbered from 0).
+fn sets_of_courses(plies: &[Vec<usize>], fps: &Footprints) -> Result<Vec<usize>, VerifyError> {
+    let g = CellGrid::new(fps);
     let mut set_of = vec![0usize; fps.courses.len()];
     let mut set = 0;
     // The current set's pieces, by cell.
     let mut grid: HashMap<(i64, i64), Vec<(usize, usize)>> = HashMap::new();
+    let mut visits = 0u64;
     for ply in plies {
-        let meets = ply.iter().any(|&c| {
-            fps.courses[c].quads.iter().any(|q| {
-                cells_of(q).any(|key| {
-                    grid.get(&key).is_some_and(|v| {
-                        v.iter()
-                            .any(|&(x, qx)| crate::precedence::quads_overlap(&fps.frame, q, &fps.courses[x].quads[qx]))
-                    })
-                })
-            })
-        });
+        let mut meets = false;
+        'ply: for &c in ply {
+            for q in &fps.courses[c].quads {
+                for key in g.keys(q) {
+                    let Some(v) = grid.get(&key) else { continue };
+                    visits += v.len() as u64;
+                    if visits > MAX_GRID_VISITS {
+                        return Err(too_dense("finding Doherty et al.'s precedence sets"));
+                    }
+                    if v.iter()
+                        .any(|&(x, qx)| crate::precedence::quads_overlap(&fps.frame, q, &fps.courses[x].quads[qx]))
+                    {
+                        meets = true;
+                        break 'ply;
+                    }
+                }
+            }
+        }
         if meets {
             set += 1;
             grid.clear();
@@ -882,25 +899,25 @@ fn sets_of_courses(plies: &[Vec<usize>], fps: &Footprints) -> Vec<usize> {
         for &c in ply {
             set_of[c] = set;
             for (qi, q) in fps.courses[c].quads.iter().enumerate() {
-                for key in cells_of(q) {
+                for key in g.keys(q) {
                     grid.entry(key).or_default().push((c, qi));
                 }
             }
         }
     }
-    set_of
+    Ok(set_of)
 }
 
-/// Every course of a seed-000 precedence set must be laid before any course of the next.
+/// Every course of a Doherty et al.'s precedence set must be laid before any course of the next.
 fn check_sets(orig: &Program, fps: &Footprints, order: &[Placement]) -> Result<(), VerifyError> {
     let plies: Vec<Vec<usize>> = orig.plies.iter().map(|p| p.courses.clone()).collect();
-    let set_of = sets_of_courses(&plies, fps);
+    let set_of = sets_of_courses(&plies, fps)?;
     let mut latest: Option<usize> = None;
     for p in order {
         if let Some(l) = latest {
             if set_of[p.course] < set_of[l] {
                 return Err(VerifyError::Order(format!(
-                    "{} (seed-000 precedence set {}) is laid after {} (set {}): each set must be finished before the next starts",
+                    "{} (Doherty et al.'s precedence set {}) is laid after {} (set {}): each set must be finished before the next starts",
                     orig.course_name(p.course),
                     set_of[p.course] + 1,
                     orig.course_name(l),
@@ -986,7 +1003,7 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
-        /// The verifier's own seed-000 sets are the optimizer's (`precedence_sets`), found by
+        /// The verifier's own Doherty et al.'s precedence sets are the optimizer's (`precedence_sets`), found by
         /// other code.
         #[test]
         fn verifier_sets_agree_with_the_optimizer_s(
@@ -998,8 +1015,8 @@ mod tests {
             let n = courses.len();
             let plies: Vec<Vec<usize>> = (0..n).collect::<Vec<_>>().chunks(per_ply).map(|c| c.to_vec()).collect();
             let fps = Footprints { frame: Frame::Plan, courses };
-            let mine = sets_of_courses(&plies, &fps);
-            let theirs = crate::precedence::precedence_sets(&fps, &plies);
+            let mine = sets_of_courses(&plies, &fps).unwrap();
+            let theirs = crate::precedence::precedence_sets(&fps, &plies).unwrap();
             let mut expect = vec![usize::MAX; n];
             for (s, ps) in theirs.iter().enumerate() {
                 for &p in ps {

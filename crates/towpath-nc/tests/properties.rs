@@ -1,13 +1,14 @@
-//! Property tests over generated programs: exact round trips; any feasible order, with any
-//! legal reversals, rewrites into a program the independent verifier accepts and whose
-//! measured off-part motion is the solver's route cost; the optimizer never returns a dearer
-//! program; the parser never panics.
+//! Property tests over generated programs: exact round trips (LF, CRLF and CR line ends); any
+//! feasible order, with any legal reversals, rewrites into a program the independent verifier
+//! accepts and whose measured off-part motion is the solver's route cost; heater switches keep
+//! their laid stretches under any order; the verifier notices any line removed or slipped in;
+//! the optimizer never returns a dearer program; the parser never panics.
 
 use proptest::prelude::*;
 use towpath_machine::{Axis, AxisKind, CostKind, Machine};
 use towpath_nc::{
-    build_problem, optimize, parse, reverse_course, rewrite, verify, AfpOptions, Clearance, Dialect, OptimizeOptions,
-    Placement, VerifyOptions, Width,
+    build_problem, optimize, parse, reverse_course, rewrite, verify, AfpOptions, Clearance, Dialect, Irreversible,
+    OptimizeOptions, Placement, Switch, VerifyOptions, Width,
 };
 use towpath_seq::{check, Step, TaskId};
 
@@ -37,13 +38,16 @@ struct CourseSpec {
     extra: u8,
     /// The last on-part move is a clockwise arc (radius = its chord), which cannot be reversed.
     arc: bool,
+    /// A heater switched on after the tow restart and off before the last cut (`M8`, `M9`).
+    heater: bool,
 }
 
 #[derive(Clone, Debug)]
 struct PartSpec {
     plies: Vec<Vec<CourseSpec>>,
     course_markers: bool,
-    crlf: bool,
+    /// Line ends: 0 LF, 1 CRLF, 2 CR.
+    ends: u8,
     final_newline: bool,
 }
 
@@ -57,9 +61,10 @@ fn course_spec() -> impl Strategy<Value = CourseSpec> {
             proptest::option::of((0usize..4, 1u64..16)),
             0u8..4,
             proptest::bool::weighted(0.2),
+            proptest::bool::weighted(0.3),
         ),
     )
-        .prop_map(|((x, y, angle, len), (points, h, mask, mid, extra, arc))| CourseSpec {
+        .prop_map(|((x, y, angle, len), (points, h, mask, mid, extra, arc, heater))| CourseSpec {
             x: (x * 1000.0).round() / 1000.0,
             y: (y * 1000.0).round() / 1000.0,
             angle,
@@ -74,6 +79,7 @@ fn course_spec() -> impl Strategy<Value = CourseSpec> {
             }),
             extra,
             arc,
+            heater,
         })
 }
 
@@ -81,13 +87,13 @@ fn part_spec() -> impl Strategy<Value = PartSpec> {
     (
         proptest::collection::vec(proptest::collection::vec(course_spec(), 1..5), 1..4),
         any::<bool>(),
-        any::<bool>(),
+        0u8..3,
         any::<bool>(),
     )
-        .prop_map(|(plies, course_markers, crlf, final_newline)| PartSpec {
+        .prop_map(|(plies, course_markers, ends, final_newline)| PartSpec {
             plies,
             course_markers,
-            crlf,
+            ends,
             final_newline,
         })
 }
@@ -122,6 +128,9 @@ fn program(spec: &PartSpec) -> String {
             l.push("G1 Z0 F1000".into());
             l.push("M20".into());
             l.push(format!("M60 P{}", c.mask));
+            if c.heater {
+                l.push("M8 (heater on)".into());
+            }
             let mut on = c.mask;
             for k in 1..=c.points {
                 let (x, y) = pt(k);
@@ -143,21 +152,55 @@ fn program(spec: &PartSpec) -> String {
                     l.push("(a note inside the course)".into());
                 }
             }
+            if c.heater {
+                l.push("M9 (heater off)".into());
+            }
             l.push(format!("M61 P{on}"));
             l.push("M21".into());
             // Retracts of two heights, so that a reversed course's approach (the retract run
             // backwards at the approach's feed) is not as long as its forward one.
             l.push(if c.mask % 2 == 0 { "G1 Z20".into() } else { "G1 Z35".into() });
+            if c.extra == 1 {
+                l.push("M9 (heater off)".into());
+            }
         }
     }
     l.push("G0 Z100".into());
     l.push("M30".into());
-    let sep = if spec.crlf { "\r\n" } else { "\n" };
+    let sep = ["\n", "\r\n", "\r"][spec.ends as usize % 3];
     let mut s = l.join(sep);
     if spec.final_newline {
         s.push_str(sep);
     }
     s
+}
+
+/// For each laid move (tows on), keyed by its end points in X, Y, Z whatever the direction:
+/// whether the heater is on while it is laid, reading `M8`/`M9` lines in the program's order.
+fn heated(p: &towpath_nc::Program) -> std::collections::BTreeMap<String, Vec<bool>> {
+    let mut on = false;
+    let mut at_line = Vec::with_capacity(p.lines.len());
+    for l in &p.lines {
+        at_line.push(on);
+        if l.starts_with("M8") {
+            on = true;
+        } else if l.starts_with("M9") {
+            on = false;
+        }
+    }
+    let key = |i: u32| p.point(i)[..3].iter().map(|v| format!("{v:.3}")).collect::<Vec<_>>().join(",");
+    // Courses may lay the same moves: each key holds all of them.
+    let mut out: std::collections::BTreeMap<String, Vec<bool>> = std::collections::BTreeMap::new();
+    for s in p.segments.iter().filter(|s| s.on_part && s.mask != 0) {
+        let (a, b) = (key(s.from), key(s.to));
+        out.entry(if a < b { format!("{a}|{b}") } else { format!("{b}|{a}") })
+            .or_default()
+            .push(at_line[s.line as usize]);
+    }
+    for v in out.values_mut() {
+        v.sort();
+    }
+    out
 }
 
 /// A random feasible order with random reversals.
@@ -212,8 +255,9 @@ proptest! {
         let afp = build_problem(&p, &m, &d, &opts).unwrap();
         let rev_ok: Vec<bool> = (0..p.courses.len()).map(|c| afp.reversed[c].is_some()).collect();
         let arcs: Vec<bool> = spec.plies.iter().flatten().map(|c| c.arc).collect();
+        let heaters: Vec<bool> = spec.plies.iter().flatten().map(|c| c.heater).collect();
         for c in 0..p.courses.len() {
-            prop_assert_eq!(rev_ok[c], !arcs[c], "course {} reversible unless it holds an arc", c);
+            prop_assert_eq!(rev_ok[c], !arcs[c] && !heaters[c], "course {} reversible unless it holds an arc or M8/M9", c);
         }
         let order = random_order(p.courses.len(), afp.problem.precedence(), &rev_ok, seed);
         let steps: Vec<Step> = order.iter().map(|pl| Step { task: TaskId(pl.course as u32), mode: pl.reversed as u32 }).collect();
@@ -248,13 +292,82 @@ proptest! {
                 prop_assert!((measured - route).abs() <= 1e-6 * (1.0 + route), "{} with clearance: measured {} route {}", cost, measured, route);
             }
         }
-        // Every course reverses with the heading turned half a turn, but those holding an arc.
+        // Every course reverses with the heading turned half a turn, but those holding an arc
+        // or codes the dialect does not describe.
         for c in 0..p.courses.len() {
             match reverse_course(&p, c, &m, &d) {
-                Ok(r) => prop_assert!(r.shift.abs() == 180.0 && !arcs[c]),
-                Err(why) => prop_assert!(arcs[c] && why.contains("arc"), "{}", why),
+                Ok(r) => prop_assert!(r.shift.abs() == 180.0 && !arcs[c] && !heaters[c]),
+                Err(Irreversible::Undescribed { words, .. }) => prop_assert!(heaters[c] && words == "M8"),
+                Err(why) => prop_assert!(arcs[c] && why.to_string().contains("arc"), "{}", why),
             }
         }
+    }
+
+    /// Declared as a switch, the heater is on along exactly the same laid moves (by their end
+    /// points, whatever the direction) in any feasible order with any legal reversals, read
+    /// from the rewritten text line by line.
+    #[test]
+    fn switches_keep_their_laid_stretches_in_any_order(spec in part_spec(), seed in any::<u64>()) {
+        let text = program(&spec);
+        let d = Dialect { switches: vec![Switch { on: "M8".into(), off: "M9".into() }], ..Dialect::default() };
+        let m = machine();
+        let p = parse(&text, &m, &d).unwrap();
+        let opts = AfpOptions { bidirectional: true, width: Some(Width::Tow(6.0)), ..AfpOptions::default() };
+        // A heater switched on before the approach of the last course is switched off in the
+        // footer, not with the course (unless the course's own M9 does): laid earlier, it would
+        // stay on for the courses after it.
+        if spec.plies.iter().flatten().last().is_some_and(|c| c.extra == 1 && !c.heater) {
+            let e = build_problem(&p, &m, &d, &opts).unwrap_err().to_string();
+            prop_assert!(e.contains("\"M8 (heater)\" leaves a switch on"), "{}", e);
+            return Ok(());
+        }
+        let afp = build_problem(&p, &m, &d, &opts).unwrap();
+        let arcs: Vec<bool> = spec.plies.iter().flatten().map(|c| c.arc).collect();
+        // A heater switched on before the course and again within it: reversed, the switch
+        // lines would not keep their stretch (it starts on), so the course is laid forward.
+        let on_before: Vec<bool> = spec.plies.iter().flatten().map(|c| c.extra == 1 && c.heater).collect();
+        let rev_ok: Vec<bool> = (0..p.courses.len()).map(|c| afp.reversed[c].is_some()).collect();
+        for c in 0..p.courses.len() {
+            prop_assert_eq!(rev_ok[c], !arcs[c] && !on_before[c], "course {}", c);
+        }
+        let order = random_order(p.courses.len(), afp.problem.precedence(), &rev_ok, seed);
+        let out = rewrite(&p, &order, &m, &d, &afp.reversed).unwrap();
+        verify(&text, &out, &m, &d, &VerifyOptions { width: Some(Width::Tow(6.0)), ..VerifyOptions::default() }).unwrap();
+        let q = parse(&out, &m, &d).unwrap();
+        prop_assert_eq!(heated(&p), heated(&q));
+    }
+
+    /// Every line of the optimized program is accounted for: removing any line is noticed (but
+    /// a repeated ply comment, a blank line, or a transit line towpath wrote, whose loss may not
+    /// change the motion checked: a set-position line before a course that writes no value of
+    /// that axis, say), and so is any of these lines slipped in anywhere.
+    #[test]
+    fn verifier_notices_any_line_removed_or_slipped_in(spec in part_spec(), at in any::<usize>(), extra in 0usize..5) {
+        let text = program(&spec);
+        let d = Dialect::default();
+        let opts = OptimizeOptions {
+            afp: AfpOptions { bidirectional: true, width: Some(Width::Tow(6.0)), ..AfpOptions::default() },
+            time_limit: None,
+            iterations: Some(50),
+            threads: 1,
+            ..OptimizeOptions::default()
+        };
+        let out = optimize(&text, &machine(), &d, &opts).unwrap().text;
+        let lines: Vec<&str> = out.lines().collect();
+        let vopts = VerifyOptions { width: Some(Width::Tow(6.0)), ..VerifyOptions::default() };
+        let i = at % lines.len();
+        let mut removed = lines.clone();
+        let gone = removed.remove(i).trim_end_matches('\r');
+        let repeated_ply = gone.starts_with("(PLY") && removed.iter().any(|l| l.trim_end_matches('\r') == gone);
+        let transit = ["G0 ", "G92 ", "G90 G0 "].iter().any(|t| gone.starts_with(t))
+            || gone.split_whitespace().all(|w| ["G0", "G1", "G90", "G91"].contains(&w) || w.starts_with('F'));
+        if !(gone.trim().is_empty() || repeated_ply || transit) {
+            prop_assert!(verify(&text, &removed.join("\n"), &machine(), &d, &vopts).is_err(), "line {} {:?} removed", i + 1, gone);
+        }
+        let mut slipped = lines.clone();
+        let new = ["M0", "G4 P5000", "(a note)", "M8", "S300"][extra];
+        slipped.insert(at % (lines.len() + 1), new);
+        prop_assert!(verify(&text, &slipped.join("\n"), &machine(), &d, &vopts).is_err(), "{:?} slipped in at line {}", new, at % (lines.len() + 1) + 1);
     }
 
     #[test]

@@ -28,7 +28,7 @@ enum Command {
     /// Generate the fiber courses of a ply on a mold surface (mesh or analytic), trimmed per tow,
     /// with quality figures; write JSON, CSV and G-code.
     Layup(Box<cmd::layup::Args>),
-    /// Re-sequence an AFP program: same part, laid identically, less off-part motion, verified.
+    /// Re-sequence an AFP program: same part, laid identically, in less cycle time, verified.
     Optimize(cmd::optimize::Args),
     /// Check an optimized AFP program against its original and print the savings.
     Verify(cmd::verify::Args),

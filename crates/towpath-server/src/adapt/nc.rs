@@ -497,19 +497,18 @@ pub fn optimize(
         apply_steps(&program, &afp, &report.solution.steps, machine, dialect, &checked.afp)
             .map_err(|e| program_error(file, e))?;
     let mut order: Vec<towpath_nc::Placement> = towpath_nc::placements(&report.solution.steps);
-    let mut fell_back = false;
-    if let Some((before, after)) = verification.motion(checked.afp.cost) {
-        if after.off_part() > before.off_part() * (1.0 + 1e-12) + 1e-9 {
-            fell_back = true;
-            let again = apply_steps(&program, &afp, &afp.original, machine, dialect, &checked.afp)
-                .map_err(|e| program_error(file, e))?;
-            out = again.0;
-            verification = again.1;
-            order = towpath_nc::placements(&afp.original);
-        }
+    // The library's guard: never a longer cycle time nor more off-part cost than the input.
+    let fallback = towpath_nc::fallback_reason(&verification, checked.afp.cost);
+    if fallback.is_some() {
+        let again = apply_steps(&program, &afp, &afp.original, machine, dialect, &checked.afp)
+            .map_err(|e| program_error(file, e))?;
+        out = again.0;
+        verification = again.1;
+        order = towpath_nc::placements(&afp.original);
     }
     let t_verify = t3.elapsed().as_secs_f64();
     let optimized_program = parse(&out, machine, dialect).map_err(|e| program_error(file, e))?;
+    let width = towpath_nc::WidthUsed::choose(checked.afp.width, dialect, &program);
     let o = Optimized {
         text: out,
         program,
@@ -531,7 +530,9 @@ pub fn optimize(
             verify: t_verify,
             total: t0.elapsed().as_secs_f64(),
         },
-        fell_back,
+        fell_back: fallback.is_some(),
+        fallback,
+        width,
     };
     let report = Report::new(file, machine, &o, &checked.afp);
     let report_json = serde_json::to_string_pretty(&report).map_err(|e| ApiError::Internal(e.to_string()))?;
@@ -583,7 +584,7 @@ pub fn optimize(
         per_ply,
         verified: report.verified,
         verdict,
-        fell_back,
+        fell_back: o.fell_back,
         solver_cost: (o.solver.initial_cost, o.solver.cost),
     })
 }

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use towpath_machine::Machine;
-use towpath_nc::{Dialect, Width};
+use towpath_nc::{Dialect, NcError, Width, WidthSource};
 
 use crate::exit;
 use crate::files::Files;
@@ -35,6 +35,14 @@ impl MachineArgs {
             files.input("dialect file", d)?;
         }
         Ok(())
+    }
+
+    /// The dialect file's name, or `the reference dialect`.
+    pub fn dialect_name(&self) -> String {
+        match &self.dialect {
+            Some(d) => d.display().to_string(),
+            None => "the reference dialect".into(),
+        }
     }
 
     /// Loads the machine and dialect files and checks the width.
@@ -71,6 +79,40 @@ fn positive(name: &str, w: f64) -> anyhow::Result<f64> {
     } else {
         Err(exit::bad_input(anyhow::anyhow!("{name} {w}: a width must be a number > 0")))
     }
+}
+
+/// Says where the machine file sets what a library error points at (the mandrel's axis for
+/// a tool point on or near it), so the message names the file to fix as well as the program.
+pub fn machine_hint(e: &NcError, machine: &Path) -> String {
+    match e {
+        NcError::MandrelAxis { axis, label, .. } => format!(
+            " (they are `origin` and `direction` of axis {label}, the [[axis]] table number {} in {})",
+            axis + 1,
+            machine.display()
+        ),
+        _ => String::new(),
+    }
+}
+
+/// Words for where a width came from, as the user gave it.
+pub fn width_from(args: &MachineArgs, used: &towpath_nc::WidthUsed, dialect: &str) -> String {
+    match used.source {
+        WidthSource::Given if args.tow_width.is_some() => "the command line, --tow-width".into(),
+        WidthSource::Given => "the command line, --course-width".into(),
+        WidthSource::Dialect => format!("the dialect, {dialect}"),
+        WidthSource::Default => "none given".into(),
+    }
+}
+
+/// Prints a warning on stderr (a closed stderr is ignored).
+pub fn warn(text: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "warning: {text}");
+}
+
+/// Counts lines holding `code`, whatever the line ends (LF, CRLF or CR).
+pub fn lines_with(text: &str, code: &str) -> usize {
+    text.split(['\n', '\r']).filter(|l| l.contains(code)).count()
 }
 
 /// Reads a text file, naming it on failure (for text that is not UTF-8, the line and byte).

@@ -1,11 +1,12 @@
 //! `towpath demo`: the whole AFP flow on built-in parts, with no files of the user's own.
 //!
-//! Writes seed 000's test parts (planar base ply and pad-ups at 0°, 45° and 90°, and three
-//! cylinders) as programs, with the machine and dialect files, into a directory; optimizes each
-//! (bidirectional, course-level precedence); writes the optimized program and an HTML report;
-//! verifies the output independently; and prints the savings beside seed 000's.
+//! Writes Doherty et al.'s (2022) test parts (planar base ply and pad-ups at 0°, 45° and 90°,
+//! and three cylinders) as programs, with the machine and dialect files, into a directory;
+//! optimizes each (cycle time by default, bidirectional, course-level precedence); writes the
+//! optimized program and an HTML report; verifies the output independently; and prints the
+//! cycle time before and after, then the distance savings beside the paper's.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use towpath_machine::CostKind;
 use towpath_nc::demo::{demo_parts, gantry, mandrel_machine, TOW_WIDTH};
@@ -28,9 +29,11 @@ pub struct Args {
     /// Work budget per part instead of a time limit: the outputs then depend only on the inputs.
     #[arg(long, value_name = "N", conflicts_with = "time_limit")]
     pub iterations: Option<u64>,
-    /// Cost model to optimize.
-    #[arg(long, default_value = "axis", value_name = "axis|time|tool")]
-    pub cost: CostKind,
+    /// What to minimize: cycle time (time, the default: the demo's machines have velocities),
+    /// Doherty et al.'s weighted axis distance (axis, the paper's cost), or the tool point's
+    /// distance (tool). A longer cycle time than the input's is never returned.
+    #[arg(long, value_name = "time|axis|tool")]
+    pub cost: Option<CostKind>,
     /// Keep every course in its original direction.
     #[arg(long)]
     pub unidirectional: bool,
@@ -43,6 +46,11 @@ pub struct Args {
     pub force: bool,
     #[command(flatten)]
     pub solver: SolverArgs,
+}
+
+/// The file the demo writes a part's machine to.
+fn machine_file(m: &towpath_machine::Machine) -> String {
+    format!("{}.toml", m.name)
 }
 
 /// Runs the demo.
@@ -71,7 +79,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     files.write(&dir.join("gantry-afp.toml"), gantry().to_toml_string())?;
     files.write(&dir.join("mandrel-afp.toml"), mandrel_machine().to_toml_string())?;
     files.write(&dir.join("dialect.toml"), dialect.to_toml_string())?;
-    let afp = AfpOptions { cost: args.cost, bidirectional: !args.unidirectional, ..AfpOptions::default() };
+    let cost = args.cost.unwrap_or_else(|| towpath_nc::default_cost(&gantry()));
+    let afp = AfpOptions { cost, bidirectional: !args.unidirectional, ..AfpOptions::default() };
     let opts = OptimizeOptions {
         afp: afp.clone(),
         time_limit: if args.iterations.is_some() { None } else { Some(time_limit) },
@@ -81,22 +90,27 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ..OptimizeOptions::default()
     };
     if !args.json {
-        outln!("towpath demo: seed 000's AFP test parts, written to {}/", dir.display());
+        outln!("towpath demo: Doherty et al.'s (2022) AFP test parts, written to {}/", dir.display());
         outln!(
             "Each program is planned badly on purpose: plies out of order, every course laid in the same direction.\n\
-             The {} solver re-sequences the courses ({}, a course after the courses of earlier plies it overlaps),\n\
-             towpath rewrites only the off-part motion and verifies the result independently.\n",
+             The {} solver re-sequences the courses for {} ({}, a course after the courses of earlier plies it\n\
+             overlaps), towpath rewrites only the off-part motion and verifies the result independently.\n\
+             Course width: tow width {TOW_WIDTH} mm × tows on, from the demo's dialect ({}).\n",
             args.solver.solver,
-            if args.unidirectional { "unidirectional" } else { "bidirectional" }
+            towpath_nc::cost_words(cost),
+            if args.unidirectional { "unidirectional" } else { "bidirectional" },
+            dir.join("dialect.toml").display()
         );
         outln!(
-            "{:<22} {:>7} {:>24} {:>8} {:>9} {:>13} {:>9}",
+            "{:<22} {:>7} {:>21} {:>7} {:>21} {:>7} {:>10} {:>9} {:>8}",
             "part",
             "courses",
-            format!("off-part ({})", args.cost),
+            "off-part time (s)",
             "saved",
-            "seed 000",
-            "total (tool)",
+            "cycle time (s)",
+            "saved",
+            "axis dist.",
+            "paper's",
             "verified"
         );
     }
@@ -105,7 +119,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let prog_path = dir.join(format!("{}.nc", part.name));
         let out_path = dir.join(format!("{}.opt.nc", part.name));
         files.write(&prog_path, &part.program)?;
-        let o = optimize(&part.program, &part.machine, &dialect, &opts).map_err(|e| classify(&prog_path, e))?;
+        let o = optimize(&part.program, &part.machine, &dialect, &opts)
+            .map_err(|e| classify(&prog_path, &dir.join(machine_file(&part.machine)), e))?;
         files.write(&out_path, &o.text)?;
         let report = Report::new(&format!("{}.nc", part.name), &part.machine, &o, &afp);
         let optimized = parse(&o.text, &part.machine, &dialect)?;
@@ -113,31 +128,46 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         // The whole flow: verify the written output again, from the texts alone.
         let v = verify(&part.program, &o.text, &part.machine, &dialect, &VerifyOptions::default())
             .map_err(|e| exit::check_failed(anyhow::anyhow!("{}: {e}", out_path.display())))?;
-        let t = report.total(args.cost).cloned();
-        let tool = report.total(CostKind::Tool).cloned();
+        // The table's figures come from this second, independent verification.
+        let totals = towpath_nc::totals(&v);
+        let of = |kind: CostKind| totals.iter().find(|t| t.kind == kind);
         let (seed_off, seed_total) = part.seed.map_or((f64::NAN, f64::NAN), |s| (s.1, s.2));
         if !args.json {
-            if let Some(t) = &t {
-                outln!(
-                    "{:<22} {:>7} {:>24} {:>7.1}% {:>9} {:>12.1}% {:>9}",
-                    part.name,
-                    v.courses,
-                    format!("{:.0} -> {:.0}", t.off_before, t.off_after),
-                    t.off_saved_percent,
-                    if seed_off.is_nan() { "-".to_string() } else { format!("{seed_off:.1}%") },
-                    tool.as_ref().map_or(f64::NAN, |x| x.total_saved_percent),
-                    "yes"
-                );
-            }
+            let span = |t: Option<&towpath_nc::Totals>, total: bool| {
+                t.map_or(("-".to_string(), "-".to_string()), |t| {
+                    let (b, a, p) = if total {
+                        (t.total_before, t.total_after, t.total_saved_percent)
+                    } else {
+                        (t.off_before, t.off_after, t.off_saved_percent)
+                    };
+                    (format!("{b:.1} -> {a:.1}"), format!("{p:.1}%"))
+                })
+            };
+            let (off, off_saved) = span(of(CostKind::Time), false);
+            let (total, total_saved) = span(of(CostKind::Time), true);
+            outln!(
+                "{:<22} {:>7} {:>21} {:>7} {:>21} {:>7} {:>10} {:>9} {:>8}",
+                part.name,
+                v.courses,
+                off,
+                off_saved,
+                total,
+                total_saved,
+                of(CostKind::Axis).map_or("-".to_string(), |t| format!("{:.1}%", t.off_saved_percent)),
+                if seed_off.is_nan() { "-".to_string() } else { format!("{seed_off:.1}%") },
+                "yes"
+            );
         }
         rows.push(serde_json::json!({
             "part": part.name,
             "description": part.description,
             "courses": v.courses,
             "reversed": v.reversed,
-            "totals": report.totals,
-            "seed_000_off_part_saved_percent": if seed_off.is_nan() { None } else { Some(seed_off) },
-            "seed_000_total_saved_percent": if seed_total.is_nan() { None } else { Some(seed_total) },
+            "cycle_time": of(CostKind::Time),
+            "totals": totals,
+            "fallback": o.fallback,
+            "doherty_2022_off_part_saved_percent": if seed_off.is_nan() { None } else { Some(seed_off) },
+            "doherty_2022_total_saved_percent": if seed_total.is_nan() { None } else { Some(seed_total) },
             "program": prog_path,
             "optimized": out_path,
             "solver": o.solver.solver,
@@ -147,15 +177,88 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     files.write(&manifest_path, manifest_text)?;
     files.commit()?;
     if args.json {
-        outln!("{}", serde_json::json!({ "dir": dir, "parts": rows }));
+        let width =
+            serde_json::json!({ "tow_width": TOW_WIDTH, "from": "dialect", "dialect": dir.join("dialect.toml") });
+        outln!("{}", serde_json::json!({ "dir": dir, "width": width, "parts": rows }));
     } else {
         outln!(
-            "\nOpen {}/planar-45.html for a before/after plan view. To run one part yourself:\n  \
-             towpath optimize {0}/planar-45.nc --machine {0}/gantry-afp.toml --dialect {0}/dialect.toml \\\n    \
-             --bidirectional -o planar-45.opt.nc --report planar-45.html\n  \
-             towpath verify {0}/planar-45.nc planar-45.opt.nc --machine {0}/gantry-afp.toml --dialect {0}/dialect.toml",
-            dir.display()
+            "\n'time' is the machine's time model (trapezoidal moves, all axes together); 'axis dist.' is the off-part\n\
+             saving in Doherty et al.'s weighted axis distance, and 'paper's' the saving their paper reports for the part."
         );
+        for line in follow_up(dir) {
+            outln!("{line}");
+        }
     }
     Ok(())
+}
+
+/// What to run next, as commands that work pasted into the shell the demo ran from: the
+/// binary by a path that reaches it from here (its name alone when it is the `towpath` on the
+/// PATH), the demo's files by the path given to `--dir`, outputs into that folder.
+pub fn follow_up(dir: &Path) -> Vec<String> {
+    let bin = invocation();
+    let q = |p: PathBuf| shell_quote(&p.display().to_string());
+    let (program, machine, dialect) =
+        (q(dir.join("planar-45.nc")), q(dir.join("gantry-afp.toml")), q(dir.join("dialect.toml")));
+    let (out, report) = (q(dir.join("planar-45.mine.nc")), q(dir.join("planar-45.mine.html")));
+    vec![
+        format!("\nOpen {} for a before/after plan view. To run one part yourself:", dir.join("planar-45.html").display()),
+        format!(
+            "  {bin} optimize {program} --machine {machine} --dialect {dialect} \\\n    --bidirectional -o {out} --report {report}"
+        ),
+        format!("  {bin} verify {program} {out} --machine {machine} --dialect {dialect}"),
+    ]
+}
+
+/// How to call this binary from the current directory: `towpath` when that name on the PATH
+/// is this binary, else the shorter of its absolute path and its path relative to here.
+fn invocation() -> String {
+    let Ok(exe) = std::env::current_exe().and_then(|e| e.canonicalize()) else {
+        return "towpath".into();
+    };
+    let on_path = std::env::var_os("PATH").is_some_and(|paths| {
+        std::env::split_paths(&paths).any(|d| d.join("towpath").canonicalize().is_ok_and(|found| found == exe))
+    });
+    if on_path {
+        return "towpath".into();
+    }
+    let relative = std::env::current_dir()
+        .and_then(|d| d.canonicalize())
+        .ok()
+        .and_then(|here| relative_to(&exe, &here))
+        .map(|r| if r.starts_with("..") { r } else { Path::new(".").join(r) });
+    let abs = exe.display().to_string();
+    match relative.map(|r| r.display().to_string()) {
+        Some(r) if r.len() < abs.len() => shell_quote(&r),
+        _ => shell_quote(&abs),
+    }
+}
+
+/// `path` relative to the directory `base` (both absolute), by `..` steps.
+fn relative_to(path: &Path, base: &Path) -> Option<PathBuf> {
+    use std::path::Component;
+    let p: Vec<Component> = path.components().collect();
+    let b: Vec<Component> = base.components().collect();
+    if p.first() != b.first() {
+        return None;
+    }
+    let common = p.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let mut out = PathBuf::new();
+    for _ in common..b.len() {
+        out.push("..");
+    }
+    for c in &p[common..] {
+        out.push(c.as_os_str());
+    }
+    Some(out)
+}
+
+/// A word as a POSIX shell reads it: unchanged when it holds only safe characters, else in
+/// single quotes.
+fn shell_quote(s: &str) -> String {
+    if !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || "/._-+:=,@%".contains(c)) {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', "'\\''"))
+    }
 }

@@ -1,4 +1,5 @@
-//! `towpath optimize`: an AFP program in, the same part with less off-part motion out, verified.
+//! `towpath optimize`: an AFP program in, the same part in less cycle time (or less off-part
+//! motion) out, verified.
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -6,7 +7,7 @@ use std::time::Duration;
 use towpath_machine::CostKind;
 use towpath_nc::{optimize, AfpOptions, NcError, OptimizeOptions, PrecedenceRule, Report};
 
-use super::afp_common::{read, MachineArgs};
+use super::afp_common::{lines_with, machine_hint, read, warn, width_from, MachineArgs};
 use super::solver_args::SolverArgs;
 use crate::files::Files;
 use crate::{exit, outln};
@@ -22,12 +23,14 @@ pub struct Args {
     /// Allow courses to be laid in reverse (heading turned 180°, tow restarts and cuts swapped).
     #[arg(long)]
     pub bidirectional: bool,
-    /// Cost of off-part moves: weighted axis distance (seed 000), motion time, or tool-point
-    /// distance.
-    #[arg(long, default_value = "axis", value_name = "axis|time|tool")]
-    pub cost: CostKind,
-    /// Precedence: a course after the courses of earlier plies it overlaps (courses), seed 000's
-    /// precedence sets (sets), or ply by ply (plies, needs no widths).
+    /// What to minimize: cycle time (time; the default when every axis of the machine file has
+    /// a max_velocity), Doherty et al.'s weighted axis distance (axis; the default otherwise),
+    /// or the tool point's distance (tool). Whatever is chosen, a program with a longer cycle
+    /// time than the input is never returned: the input order is kept instead.
+    #[arg(long, value_name = "time|axis|tool")]
+    pub cost: Option<CostKind>,
+    /// Precedence: a course after the courses of earlier plies it overlaps (courses), Doherty et
+    /// al.'s precedence sets (sets), or ply by ply (plies, needs no widths).
     #[arg(long, default_value = "courses", value_name = "courses|sets|plies")]
     pub precedence: PrecedenceRule,
     /// Keep the order of the courses within each ply.
@@ -59,13 +62,15 @@ pub struct Args {
     pub solver: SolverArgs,
 }
 
-/// Maps an optimization error to an exit code, naming the program file.
-pub fn classify(file: &std::path::Path, e: NcError) -> anyhow::Error {
+/// Maps an optimization error to an exit code, naming the program file (and the machine file
+/// where the error lies in it).
+pub fn classify(file: &std::path::Path, machine: &std::path::Path, e: NcError) -> anyhow::Error {
+    let hint = machine_hint(&e, machine);
     match e {
         NcError::SelfCheck(_) => exit::check_failed(anyhow::anyhow!("{}: {e}", file.display())),
         // Everything else, a solver that cannot take this program (`NcError::Solver`) included,
         // refuses the input.
-        _ => exit::bad_input(anyhow::anyhow!("{}: {e}", file.display())),
+        _ => exit::bad_input(anyhow::anyhow!("{}: {e}{hint}", file.display())),
     }
 }
 
@@ -82,7 +87,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let (machine, dialect, width) = args.machine.load()?;
     let text = read(&args.program)?;
     let afp = AfpOptions {
-        cost: args.cost,
+        cost: args.cost.unwrap_or_else(|| towpath_nc::default_cost(&machine)),
         bidirectional: args.bidirectional,
         precedence: args.precedence,
         keep_ply_order: args.keep_ply_order,
@@ -93,7 +98,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (Some(t), _) => Some(t),
         (None, Some(_)) => None,
         (None, None) => Some({
-            let courses = text.lines().filter(|l| l.contains(dialect.contact_on.as_str())).count().max(1);
+            let courses = lines_with(&text, dialect.contact_on.as_str()).max(1);
             towpath_nc::auto_time_limit(if dialect.contact_on.is_empty() { 1000 } else { courses })
         }),
     };
@@ -114,7 +119,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         solver: args.solver.solver,
         baselines: args.solver.params(),
     };
-    let o = optimize(&text, &machine, &dialect, &opts).map_err(|e| classify(&args.program, e));
+    let o = optimize(&text, &machine, &dialect, &opts).map_err(|e| classify(&args.program, &args.machine.machine, e));
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -122,11 +127,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     files.write(&args.output, &o.text)?;
     let name =
         args.program.file_name().map_or_else(|| args.program.display().to_string(), |n| n.to_string_lossy().into());
-    let report = Report::new(&name, &machine, &o, &afp);
+    let mut report = Report::new(&name, &machine, &o, &afp);
+    report.width_from = width_from(&args.machine, &o.width, &args.machine.dialect_name());
+    for w in &report.warnings {
+        warn(w);
+    }
     if let Some(path) = &args.report {
         let body = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("html") || e.eq_ignore_ascii_case("htm"))
         {
-            let optimized = towpath_nc::parse(&o.text, &machine, &dialect).map_err(|e| classify(&args.output, e))?;
+            let optimized = towpath_nc::parse(&o.text, &machine, &dialect)
+                .map_err(|e| classify(&args.output, &args.machine.machine, e))?;
             report.to_html(&o, &optimized, &machine)
         } else {
             serde_json::to_string_pretty(&report)?

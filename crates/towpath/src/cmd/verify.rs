@@ -1,11 +1,11 @@
 //! `towpath verify`: checks an optimized AFP program against its original, independently of the
-//! optimizer, and prints the off-part motion before and after.
+//! optimizer, and prints the cycle time and the off-part motion before and after.
 
 use std::path::PathBuf;
 
 use towpath_nc::{totals, verify, PrecedenceRule, VerifyError, VerifyOptions};
 
-use super::afp_common::{read, MachineArgs};
+use super::afp_common::{machine_hint, read, warn, width_from, MachineArgs};
 use crate::{exit, outln};
 
 /// Arguments of `towpath verify`.
@@ -20,7 +20,7 @@ pub struct Args {
     #[command(flatten)]
     pub machine: MachineArgs,
     /// The precedence the optimized program must keep: a course after the courses of earlier
-    /// plies it overlaps (courses, always checked), and also seed 000's precedence sets in order
+    /// plies it overlaps (courses, always checked), and also Doherty et al.'s precedence sets in order
     /// (sets) or every ply finished before the next starts (plies), as `optimize --precedence`.
     #[arg(long, default_value = "courses", value_name = "courses|sets|plies")]
     pub precedence: PrecedenceRule,
@@ -46,15 +46,33 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         keep_ply_order: args.keep_ply_order,
         seed000_sets: args.precedence == PrecedenceRule::Sets,
     };
+    let m = &args.machine.machine;
     let v = verify(&original, &optimized, &machine, &dialect, &opts).map_err(|e| match e {
-        VerifyError::Original(e) => exit::bad_input(anyhow::anyhow!("{}: {e}", args.original.display())),
-        VerifyError::Optimized(e) => exit::bad_input(anyhow::anyhow!("{}: {e}", args.optimized.display())),
-        VerifyError::Setup(e) => exit::bad_input(anyhow::anyhow!("{e}")),
+        VerifyError::Original(e) => {
+            exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.original.display(), machine_hint(&e, m)))
+        }
+        VerifyError::Optimized(e) => {
+            exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.optimized.display(), machine_hint(&e, m)))
+        }
+        VerifyError::Setup(e) => {
+            exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.original.display(), machine_hint(&e, m)))
+        }
         e => {
             exit::check_failed(anyhow::anyhow!("{} against {}: {e}", args.optimized.display(), args.original.display()))
         }
     })?;
     let t = totals(&v);
+    let from = width_from(&args.machine, &v.width, &args.machine.dialect_name());
+    if let Some(w) = &v.width.warning {
+        warn(w);
+    }
+    let per_tow = if matches!(v.width.width, Some(towpath_nc::Width::Tow(_))) { " × tows on" } else { "" };
+    let width = match (&v.width.width, v.precedence_checked) {
+        (Some(_), true) => format!("{}{per_tow} (from {from})", v.width.describe()),
+        (Some(_), false) => format!("{}{per_tow} (from {from}; no footprints needed)", v.width.describe()),
+        (None, _) if v.ply_order_checked => "none (ply by ply: no footprints needed)".to_string(),
+        (None, _) => "none (one ply: no footprints needed)".to_string(),
+    };
     if args.json {
         outln!(
             "{}",
@@ -63,6 +81,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 "courses": v.courses,
                 "reversed": v.reversed,
                 "precedence_checked": v.precedence_checked,
+                "ply_order_checked": v.ply_order_checked,
+                "width": v.width,
+                "width_from": from,
+                "warnings": v.width.warning.iter().collect::<Vec<_>>(),
+                "cycle_time": t.iter().find(|x| x.kind == towpath_machine::CostKind::Time),
                 "totals": t,
             })
         );
@@ -73,34 +96,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         v.courses,
         v.reversed,
         match (v.precedence_checked, opts.seed000_sets, opts.strict_plies) {
+            (false, _, true) => "kept (ply by ply)",
             (false, ..) => "not needed (one ply)",
-            (true, true, _) => "kept (and seed 000's precedence sets in order)",
+            (true, true, _) => "kept (and Doherty et al.'s precedence sets in order)",
             (true, _, true) => "kept (and ply by ply)",
             (true, ..) => "kept",
         }
     );
-    outln!(
-        "  {:<6} {:>14} {:>14} {:>8} {:>14} {:>14} {:>8}",
-        "cost",
-        "off-part in",
-        "off-part out",
-        "saved",
-        "total in",
-        "total out",
-        "saved"
-    );
-    for x in &t {
-        outln!(
-            "  {:<6} {:>14.1} {:>14.1} {:>7.1}% {:>14.1} {:>14.1} {:>7.1}%   ({})",
-            x.kind.name(),
-            x.off_before,
-            x.off_after,
-            x.off_saved_percent,
-            x.total_before,
-            x.total_after,
-            x.total_saved_percent,
-            x.unit
-        );
+    // Cycle time first, then distance.
+    for line in towpath_nc::headline(&t) {
+        outln!("  {line}");
     }
+    outln!("  width: {width}");
+    crate::out!("{}", towpath_nc::totals_table(&t));
     Ok(())
 }

@@ -153,7 +153,7 @@ fn bad_input_names_file_and_line() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-/// `towpath optimize --solver NAME`: the seed papers' solvers sequence the same program, their
+/// `towpath optimize --solver NAME`: the published solvers (docs/references.md) sequence the same program, their
 /// answers are written and verified like towpath's, and the report says which solver ran.
 #[test]
 fn optimize_with_each_solver() {
@@ -193,7 +193,7 @@ fn optimize_with_each_solver() {
         assert_eq!(code, 0, "{solver}: {err}");
         assert!(stdout.starts_with("verified: 30 courses"), "{solver}: {stdout}");
     }
-    // Seed 000's solver lays each precedence set freely: it cannot keep the ply order.
+    // Doherty et al.'s solver lays each precedence set freely: it cannot keep the ply order.
     let (code, _, err) = optimize("doherty", &["--keep-ply-order"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("planar-0.nc") && err.contains("doherty") && err.contains("--keep-ply-order"), "{err}");
@@ -227,13 +227,22 @@ fn course_width_html_report_and_sets_precedence() {
         "{}",
         &page[..200.min(page.len())]
     );
+    // Plan view: plies coloured with a legend, an arrow per laid course, a start marker and a
+    // scale bar in each of the two views.
+    assert_eq!(page.matches("class=\"start\"").count(), 2, "start markers");
+    assert_eq!(page.matches("<g class=\"scale\">").count(), 2, "scale bars");
+    assert!(page.matches("marker-end=").count() >= 2 * 30, "an arrow per course in each view");
+    for ply in 1..=4 {
+        assert!(page.contains(&format!("</i>ply {ply}</span>")), "legend for ply {ply}");
+    }
+    assert!(page.find("cycle time: off-part").unwrap() < page.find("<h2>Totals").unwrap(), "time leads");
     let mut cmd = towpath();
     cmd.arg("verify").arg(d.join("planar-0.nc")).arg(&out);
     base(&mut cmd);
     cmd.args(["--precedence", "sets"]);
     let (code, stdout, err) = run(&mut cmd);
     assert_eq!(code, 0, "{err}");
-    assert!(stdout.contains("seed 000's precedence sets in order"), "{stdout}");
+    assert!(stdout.contains("Doherty et al.'s precedence sets in order"), "{stdout}");
     // Both widths at once: refused by the argument parser.
     let mut cmd = towpath();
     cmd.arg("verify").arg(d.join("planar-0.nc")).arg(&out);

@@ -2,8 +2,10 @@
 //! `common`).
 
 mod afp;
+mod afp_hardening;
 mod common;
 mod convert;
+mod cycle_time;
 mod layup;
 mod machine;
 mod order;
