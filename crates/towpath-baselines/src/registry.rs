@@ -140,6 +140,14 @@ pub enum BaselineError {
     /// A parameter is out of range.
     #[error("bad parameter: {0}")]
     BadParams(String),
+    /// A parameter asks for more memory or work than the solver takes on.
+    #[error("{message}")]
+    TooMuch {
+        /// The parameter, as a field path of [`BaselineParams`] (`ga.population`).
+        param: &'static str,
+        /// What it would take and what is allowed.
+        message: String,
+    },
 }
 
 /// Solves `problem` with the named solver.
