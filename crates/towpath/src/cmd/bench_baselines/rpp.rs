@@ -74,7 +74,7 @@ pub fn run(args: &Args) -> anyhow::Result<String> {
             aco_vs_ga: Vec::new(),
         };
         for s in 1..=seeds {
-            let model = RppModel::new(seed004_like(r, s))?;
+            let model = RppModel::new(seed004_like(r, s)?)?;
             let p = model.problem();
             let mut inst: Vec<Vec<(f64, f64)>> = vec![Vec::new(); 3 + limits.len()];
             for k in 1..=runs {
