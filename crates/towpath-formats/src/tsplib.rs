@@ -249,6 +249,15 @@ fn read_costs(doc: &Document<'_>, kind: Kind, n: usize, path: &Path) -> Result<C
     Ok(Costs::Points(cost))
 }
 
+/// A coordinate for a message: plain when short, else in exponent form (`4e19`).
+fn number(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// Refuses points so far apart that a route of `moves` integer distances (TSPLIB's roundings)
 /// could exceed 2⁵³ and no longer add up exactly, naming the two states farthest apart (by
 /// `label`) and pointing at `line`.
@@ -268,14 +277,14 @@ pub(crate) fn check_exact(
     let (pa, pb) = (cost.points()[a.index()], cost.points()[b.index()]);
     let axis = (0..3).max_by(|&x, &y| (pb[x] - pa[x]).abs().total_cmp(&(pb[y] - pa[y]).abs())).unwrap_or(0);
     let what = format!(
-        "{} ({} = {:e}) and {} ({} = {:e}) are {:e} apart",
+        "{} ({} = {}) and {} ({} = {}) are {} apart",
         label(a.0),
         ["x", "y", "z"][axis],
-        pa[axis],
+        number(pa[axis]),
         label(b.0),
         ["x", "y", "z"][axis],
-        pb[axis],
-        (pb[axis] - pa[axis]).abs()
+        number(pb[axis]),
+        number((pb[axis] - pa[axis]).abs())
     );
     Err(FormatError::at_line(path, line, ErrorKind::InexactCosts { what, moves, bound, scale: "coordinates".into() }))
 }

@@ -192,6 +192,56 @@ fn bad_output_paths_are_the_users_error() {
 }
 
 #[test]
+fn convert_and_route_outputs_where_nothing_may_be_written_exit_2() {
+    let d = scratch("paths2");
+    let att = data("att48.tsp").display().to_string();
+    let graph = fixture("rpp_6re.json").display().to_string();
+    let nowhere = "/proc/towpath-no-such-file.json".to_string();
+    let mut cases: Vec<Vec<String>> = vec![
+        vec!["convert".into(), att.clone(), "-o".into(), nowhere.clone()],
+        vec!["route".into(), graph.clone(), "--time-limit".into(), "0.1".into(), "-o".into(), nowhere.clone()],
+        vec!["route".into(), graph.clone(), "--time-limit".into(), "0.1".into(), "--save-instance".into(), nowhere],
+        vec!["route".into(), graph.clone(), "--time-limit".into(), "0.1".into(), "-o".into(), d.display().to_string()],
+    ];
+    // Permission denied (not testable as root, who may write anywhere).
+    let locked = d.join("locked");
+    std::fs::create_dir_all(&locked).unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o500)).unwrap();
+        if std::fs::write(locked.join("probe"), "x").is_err() {
+            cases.push(vec!["convert".into(), att.clone(), "-o".into(), locked.join("x.json").display().to_string()]);
+            cases.push(vec![
+                "route".into(),
+                graph.clone(),
+                "--time-limit".into(),
+                "0.1".into(),
+                "-o".into(),
+                locked.join("r.json").display().to_string(),
+            ]);
+        }
+    }
+    for args in &cases {
+        let (code, _, err) = run(towpath().args(args));
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(!err.contains("bug") && !err.contains("panicked"), "{args:?}: {err}");
+    }
+    // Missing folders are made.
+    let deep = d.join("new/deeper/att48.json");
+    let (code, _, err) = run(towpath().args(["convert", &att, "-o"]).arg(&deep));
+    assert_eq!(code, 0, "{err}");
+    assert!(deep.exists());
+    let deep = d.join("more/route.json");
+    let (code, _, err) = run(towpath().args(["route", &graph, "--time-limit", "0.1", "-o"]).arg(&deep));
+    assert_eq!(code, 0, "{err}");
+    assert!(deep.exists());
+    // solve writes no file; an input that is a folder is the user's error too.
+    let (code, _, err) = run(towpath().arg("solve").arg(&d));
+    assert_eq!(code, 2, "{err}");
+}
+
+#[test]
 fn demo_replaces_only_its_own_files() {
     let d = demo("demo-own");
     // A second run replaces the demo's own files.

@@ -132,7 +132,8 @@ fn generated_sizes_are_bounded_and_said() {
     }
     let (code, _, err) = run(towpath().args(["route", "--generate", "0"]));
     assert_eq!(code, 2, "{err}");
-    let (code, _, err) = run(towpath().args(["route", "--generate", "5", "--solver", "ga", "--ga-population", "4000000000"]));
+    let (code, _, err) =
+        run(towpath().args(["route", "--generate", "5", "--solver", "ga", "--ga-population", "4000000000"]));
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("(--ga-population)"), "{err}");
 }
@@ -143,7 +144,8 @@ fn the_whole_command_honours_its_time_limit() {
     // 1 s limit before, 30 s and more on a loaded machine). Either the command finishes within
     // its limit or it says, within the limit, what the paths need.
     let t0 = std::time::Instant::now();
-    let (code, out, err) = run(towpath().args(["route", "--generate", "3000", "--time-limit", "0.5", "--threads", "2"]));
+    let (code, out, err) =
+        run(towpath().args(["route", "--generate", "3000", "--time-limit", "0.5", "--threads", "2"]));
     let took = t0.elapsed().as_secs_f64();
     match code {
         0 => assert!(out.contains("verified           : yes"), "{out}"),
@@ -159,4 +161,25 @@ fn the_summary_says_the_route_was_verified() {
     let (code, out, err) = run(towpath().arg("route").arg(fixture("rpp_6re.json")).args(["--time-limit", "0.2"]));
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("verified           : yes (independent check"), "{out}");
+}
+
+#[test]
+fn benchmark_budgets_are_checked_before_any_work() {
+    // `bench baselines` runs seed 004's instances first; a budget that is not a duration
+    // (it panicked in Duration::from_secs_f64) or a count that never ends is refused up front.
+    for args in [
+        &["--towpath-ms", "-1"][..],
+        &["--towpath-ms", "1,nan"],
+        &["--reference-ms", "1e300"],
+        &["--gtsp-seconds", "-2"],
+        &["--runs", "1000000000000"],
+        &["--gtsp-threads", "100000"],
+    ] {
+        let t0 = std::time::Instant::now();
+        let given = format!("{}={}", args[0], args[1]);
+        let (code, _, err) = run(towpath().args(["bench", "baselines", &given]));
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(args[0]) && !err.contains("panicked"), "{args:?}: {err}");
+        assert!(t0.elapsed().as_secs_f64() < 5.0, "{args:?} ran");
+    }
 }

@@ -193,7 +193,8 @@ EDGE_WEIGHT_SECTION\n0 5 100\n1 0 7\n9 1 0\nFIXED_EDGES_SECTION\n1 3\n-1\nEOF\n"
 #[test]
 fn sizes_taken_on_trust_are_refused_with_their_flag() {
     let att = data("att48.tsp");
-    let (code, _, err) = run(towpath().arg("solve").arg(&att).args(["--solver", "ga", "--ga-population", "4000000000"]));
+    let (code, _, err) =
+        run(towpath().arg("solve").arg(&att).args(["--solver", "ga", "--ga-population", "4000000000"]));
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("(--ga-population)") && err.contains("at most"), "{err}");
     assert!(!err.contains("memory allocation"), "{err}");
