@@ -174,6 +174,7 @@ pub fn generate(req: &LayupRequest, mesh: &Mesh, progress: &mut dyn FnMut(usize)
         coverage_percent: spec.coverage.percent(),
         method: spec.method,
         ply_number: 1,
+        input_units: towpath_layup::units::Units::Mm,
     };
     let courses_json = output::to_json(&ply, &meta).to_string();
     let gcode = output::to_gcode(&ply, &meta, &Post::default());
