@@ -24,7 +24,6 @@
 mod generate;
 mod instance;
 mod json;
-mod locate;
 mod model;
 mod paths;
 

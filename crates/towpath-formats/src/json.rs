@@ -302,7 +302,7 @@ impl JsonProblem {
     /// Checks the states and returns their number.
     fn check_states(&self, ctx: &Ctx<'_>) -> Result<usize, FormatError> {
         let st = &self.states;
-        let at = |rest: &[Seg]| [&[Seg::Key("states")][..], rest].concat();
+        let at = |rest: &[Seg<'static>]| [&[Seg::Key("states")][..], rest].concat();
         match (&st.points, &st.matrix) {
             (Some(_), Some(_)) => Err(ctx.invalid(&at(&[]), "give either `points` or `matrix`, not both".into())),
             (None, None) => Err(ctx.invalid(&at(&[]), "give `points` (with a `metric`) or `matrix`".into())),

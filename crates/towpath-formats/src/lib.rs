@@ -25,7 +25,7 @@ mod error;
 mod export;
 mod instance;
 mod json;
-mod json_locate;
+pub mod json_locate;
 mod json_shape;
 mod matrix;
 mod sets;

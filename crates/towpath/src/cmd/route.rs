@@ -1,4 +1,4 @@
-//! `towpath route`: the open rural postman job of seed 004. Reads a travel graph with required
+//! `towpath route`: the open rural postman job of Tewolde & Sheng (2008). Reads a travel graph with required
 //! edges (JSON), orders and orients the required edges so that the connecting travel along
 //! shortest paths is least, and writes the full vertex walk.
 
@@ -19,8 +19,8 @@ use crate::{exit, outln};
 
 /// Arguments of `towpath route`.
 #[derive(clap::Args, Debug)]
-#[command(after_long_help = "Integrates separate tool paths into one open route (seed 004's open rural postman \
-problem). The input is a travel graph in JSON: vertices with coordinates, undirected edges with lengths, \
+#[command(after_long_help = "Integrates separate tool paths into one open route (the open rural postman \
+problem of Tewolde & Sheng 2008). The input is a travel graph in JSON: vertices with coordinates, undirected edges with lengths, \
 some edges marked \"required\" (each a tool path to be done once, in either direction). The tool travels \
 between required edges along shortest paths. The output is the full vertex walk, including connecting paths.
 
@@ -32,7 +32,7 @@ pub struct Args {
     /// The travel graph (JSON). Omit with --generate.
     #[arg(value_name = "GRAPH.json", required_unless_present = "generate")]
     pub graph: Option<PathBuf>,
-    /// Instead of reading a file, generate an instance shaped like seed 004's sample data with
+    /// Instead of reading a file, generate an instance shaped like Tewolde & Sheng's (2008) sample data with
     /// this many required edges (and twice as many vertices).
     #[arg(long, value_name = "R", conflicts_with = "graph")]
     pub generate: Option<usize>,

@@ -9,8 +9,8 @@ use crate::exit;
 #[derive(clap::Args, Debug, Clone)]
 pub struct SolverArgs {
     /// The solver: towpath (towpath's own, the best), or one of the seed papers' algorithms for
-    /// comparison: doherty (seed 000 §3.2), castelino (seed 003, GTSP→TSP transformation),
-    /// ga (seed 004 §IV), aco1 / aco2 (seed 004 §V, one or two ants per task; aco = aco2).
+    /// comparison: doherty (Doherty et al. 2022, §3.2), castelino (Castelino et al. 2003, GTSP→TSP transformation),
+    /// ga (Tewolde & Sheng 2008, §IV), aco1 / aco2 (Tewolde & Sheng 2008, §V, one or two ants per task; aco = aco2).
     #[arg(long, value_enum, default_value_t = SolverName::Towpath, help_heading = "Solver")]
     pub solver: SolverName,
     /// GA: generations (paper: 100 is enough for most sizes; Table I used 1000).
