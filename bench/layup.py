@@ -198,8 +198,8 @@ def main():
     args = ap.parse_args()
     os.makedirs(OUT, exist_ok=True)
     subprocess.check_call(["cargo", "build", "--release", "-q", "-p", "towpath"], cwd=ROOT)
-    subprocess.check_call(["cargo", "run", "--release", "-q", "-p", "towpath-layup", "--example", "layup_bench", "--",
-                           OUT, str(args.repeats)], cwd=ROOT)
+    subprocess.check_call(["cargo", "run", "--release", "-q", "-p", "towpath-bench", "--", "layup",
+                           OUT, "--repeats", str(args.repeats)], cwd=ROOT)
     py = venv_py
     load = os.getloadavg()
     pp = pp3d_traces(py, args.repeats)

@@ -1,6 +1,6 @@
 """Tests of the benchmark's pure pieces (bench/seqlib.py): route checking, the GTSP -> ATSP
 transformation, medians, gaps and the table. Run with `python3 -m unittest bench/test_seq.py`
-(standard library only; not part of CI)."""
+(standard library only; .ci/run runs it)."""
 
 from __future__ import annotations
 

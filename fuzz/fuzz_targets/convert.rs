@@ -1,28 +1,7 @@
-//! Fuzzes `Instance::to_json` (what `towpath convert` writes): any problem a reader accepts,
-//! written as towpath JSON (points or matrix) and read back, must be accepted again with the same
-//! tasks and give the same checker verdict and cost for a route.
+//! cargo-fuzz entry point of the `convert` target; the body is `fuzz/bodies/convert.rs`.
 #![no_main]
 
-use std::path::Path;
+#[path = "../bodies/convert.rs"]
+mod target;
 
-use libfuzzer_sys::fuzz_target;
-use towpath_formats::{parse_instance, parse_json, write_json, CostsAs};
-use towpath_seq::{Step, TaskId};
-
-fuzz_target!(|data: &[u8]| {
-    let text = String::from_utf8_lossy(data);
-    let Ok(inst) = parse_instance(&text, Path::new("fuzz.tsp")) else { return };
-    let steps: Vec<Step> = (0..inst.num_tasks() as u32).map(|t| Step { task: TaskId(t), mode: 0 }).collect();
-    let expected = inst.problem.check(&steps);
-    let small = inst.problem.num_states() <= 300;
-    for costs in [CostsAs::Native, CostsAs::Matrix] {
-        if costs == CostsAs::Matrix && !small {
-            continue;
-        }
-        let json = write_json(&inst.to_json(costs));
-        let back = parse_json(&json, Path::new("converted.json"))
-            .unwrap_or_else(|e| panic!("a converted problem was refused: {e}\n{json}"));
-        assert_eq!(back.num_tasks(), inst.num_tasks());
-        assert_eq!(back.problem.check(&steps).ok(), expected.clone().ok(), "{costs:?}");
-    }
-});
+libfuzzer_sys::fuzz_target!(|data: &[u8]| target::run(data));

@@ -1,21 +1,7 @@
-//! Fuzzes the JSON problem reader: no input may make it panic, an accepted problem must be
-//! usable, and what it accepts must survive a write/read round trip unchanged.
+//! cargo-fuzz entry point of the `json` target; the body is `fuzz/bodies/json.rs`.
 #![no_main]
 
-use std::path::Path;
+#[path = "../bodies/json.rs"]
+mod target;
 
-use libfuzzer_sys::fuzz_target;
-use towpath_seq::{Step, TaskId};
-
-fuzz_target!(|data: &[u8]| {
-    let text = String::from_utf8_lossy(data);
-    let Ok(problem) = towpath_formats::parse_json_problem(&text, Path::new("fuzz.json")) else { return };
-    let again = towpath_formats::write_json(&problem);
-    let back = towpath_formats::parse_json_problem(&again, Path::new("again.json"));
-    assert_eq!(back.ok().as_ref(), Some(&problem), "write/read round trip changed the problem");
-    if let Ok(inst) = problem.to_instance(&text, Path::new("fuzz.json")) {
-        let steps: Vec<Step> = (0..inst.num_tasks() as u32).map(|t| Step { task: TaskId(t), mode: 0 }).collect();
-        let _ = inst.problem.check(&steps);
-        let _ = inst.answer(&steps);
-    }
-});
+libfuzzer_sys::fuzz_target!(|data: &[u8]| target::run(data));

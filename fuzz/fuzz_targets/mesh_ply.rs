@@ -1,17 +1,7 @@
-//! Fuzz the PLY reader and the mesh build behind it: any bytes give a soup or an error, and a soup
-//! gives a mesh or an error, never a panic.
+//! cargo-fuzz entry point of the `mesh_ply` target; the body is `fuzz/bodies/mesh_ply.rs`.
 #![no_main]
 
-use libfuzzer_sys::fuzz_target;
-use towpath_geom::io::{read_bytes, Format};
-use towpath_geom::{BuildOptions, Mesh};
+#[path = "../bodies/mesh_ply.rs"]
+mod target;
 
-fuzz_target!(|data: &[u8]| {
-    if let Ok(soup) = read_bytes(data, Format::Ply) {
-        if soup.triangles.len() <= 10_000 {
-            if let Ok((mesh, _)) = Mesh::build(&soup, &BuildOptions::default()) {
-                let _ = mesh.closest_point(towpath_geom::DVec3::ZERO);
-            }
-        }
-    }
-});
+libfuzzer_sys::fuzz_target!(|data: &[u8]| target::run(data));

@@ -1,16 +1,7 @@
-//! The open rural postman JSON reader must never panic; whatever it accepts must build a model,
-//! and its own output must read back to the same instance.
+//! cargo-fuzz entry point of the `rpp_json` target; the body is `fuzz/bodies/rpp_json.rs`.
 #![no_main]
 
-use libfuzzer_sys::fuzz_target;
+#[path = "../bodies/rpp_json.rs"]
+mod target;
 
-fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else { return };
-    if let Ok(instance) = towpath_coverage::read_instance(text) {
-        let again = towpath_coverage::read_instance(&towpath_coverage::write_instance(&instance));
-        assert_eq!(again.as_ref().ok(), Some(&instance));
-        if instance.vertices().len() <= 200 {
-            let _ = towpath_coverage::RppModel::new(instance);
-        }
-    }
-});
+libfuzzer_sys::fuzz_target!(|data: &[u8]| target::run(data));

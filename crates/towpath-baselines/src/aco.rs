@@ -32,15 +32,22 @@
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
-use towpath_seq::{CostModel, Problem, SolveOptions, SolveReport, StateId, Step, TaskId};
+use towpath_seq::{Clock, CostModel, Problem, SolveOptions, SolveReport, StateId, Step, TaskId};
 
-use crate::common::{finish, Clock};
+use crate::common::finish;
 use crate::order::OrderBuilder;
 use crate::BaselineError;
 
 /// Largest number of distinct states the ant system keeps trails for (two dense
 /// states × states matrices).
 pub const ACO_MAX_STATES: usize = 2048;
+
+/// Most ants per required edge (the paper has one or two).
+pub const ACO_MAX_ANTS_PER_TASK: usize = 64;
+
+/// Most moves one ant may weigh on its walk (tasks × (tasks + modes)): every walk is done in
+/// full, the first one even after the time limit.
+pub const ACO_MAX_WALK: u64 = 100_000_000;
 
 /// Parameters of the ant system (seed 004 §V, §VI-B).
 #[derive(Clone, Debug, PartialEq)]
@@ -89,6 +96,15 @@ impl AcoParams {
         }
         if self.ants_per_task == 0 {
             return Err(BaselineError::BadParams("ACO needs at least one ant per required edge".into()));
+        }
+        if self.ants_per_task > ACO_MAX_ANTS_PER_TASK {
+            return Err(BaselineError::TooMuch {
+                param: "aco.ants_per_task",
+                message: format!(
+                    "{} ants per required edge asked for; the ant system deploys at most {ACO_MAX_ANTS_PER_TASK}",
+                    self.ants_per_task
+                ),
+            });
         }
         if let Some(t) = self.initial_trail {
             if !(t.is_finite() && t > 0.0) {
@@ -271,7 +287,7 @@ pub fn solve_aco<C: CostModel>(
     opts: &SolveOptions,
 ) -> Result<SolveReport, BaselineError> {
     params.validate()?;
-    let clock = Clock::new(opts);
+    let clock = Clock::for_options(opts);
     let n = p.num_tasks();
     let states = States::new(p);
     let s = states.list.len();
@@ -279,6 +295,17 @@ pub fn solve_aco<C: CostModel>(
         return Err(BaselineError::TooLarge {
             solver: crate::SolverName::Aco1,
             what: format!("{s} distinct states; the ant system keeps dense trails for at most {ACO_MAX_STATES}"),
+        });
+    }
+    let modes: usize = p.tasks().map(|t| p.modes(t).len()).sum();
+    let walk = n as u64 * (n + modes) as u64;
+    if walk > ACO_MAX_WALK {
+        return Err(BaselineError::TooLarge {
+            solver: crate::SolverName::Aco1,
+            what: format!(
+                "{n} tasks with {modes} modes: one ant weighs {walk} moves on its walk, the ant system at most \
+                 {ACO_MAX_WALK}"
+            ),
         });
     }
     let cm = p.cost_model();
@@ -373,6 +400,9 @@ pub fn solve_aco<C: CostModel>(
         place_ants(&mut ants, &mut rng);
         let mut cycle_best = f64::INFINITY;
         for &(t, m) in &ants {
+            if clock.expired() {
+                break;
+            }
             let (steps, conns) = colony.walk(&tv, Some((t, m)), &mut rng, false);
             let tl = route_cost(&steps);
             cycle_best = cycle_best.min(tl);

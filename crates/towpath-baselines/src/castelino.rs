@@ -40,13 +40,20 @@
 //! route (precedence between clusters holds node by node); a tour that pays `M` once per
 //! cluster maps to a route of cost `tour cost − m·M`.
 
-use towpath_seq::{CostModel, End, Mode, Problem, SolveOptions, SolveReport, StateId, Step, TaskId};
+use towpath_seq::{Clock, CostModel, End, Mode, Problem, SolveOptions, SolveReport, StateId, Step, TaskId};
 
-use crate::common::{finish, initial_cost, Clock};
+use crate::common::{finish, initial_cost};
 use crate::BaselineError;
 
 /// Largest transformed problem (2 × total modes) the solver builds.
 pub const CASTELINO_MAX_NODES: usize = 200_000;
+
+/// Most node-level precedence pairs the transformed problem may hold (a rule between two
+/// clusters holds between each of their 2·k nodes: 4·k·k' pairs).
+pub const CASTELINO_MAX_PRECEDENCE_PAIRS: u64 = 1 << 24;
+
+/// Most tasks whose precedence rules are reduced (a reachability table of n² bits).
+const REDUCE_MAX_TASKS: usize = 46_000;
 
 /// Parameters of the transformation.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -277,6 +284,27 @@ pub fn transformed_problem<'t, 'p, C: CostModel>(
 ) -> Result<Problem<&'t Transformed<'p, C>>, BaselineError> {
     let p = t.p;
     let n = t.n as u32;
+    let reduced = reduced_precedence(p)?;
+    // Count the node-level precedence pairs before making any.
+    let nodes = |task: TaskId| 2 * p.modes(task).len() as u64;
+    let all = 2 * t.n as u64;
+    let mut pairs: u64 = reduced.iter().map(|&(a, c)| nodes(a) * nodes(c)).sum();
+    if let Some(f) = p.first_task() {
+        pairs += nodes(f) * (all - nodes(f)) + nodes(f);
+    }
+    if let Some(l) = p.last_task() {
+        pairs += nodes(l) * (all - nodes(l));
+    }
+    if pairs > CASTELINO_MAX_PRECEDENCE_PAIRS {
+        return Err(BaselineError::TooLarge {
+            solver: crate::SolverName::Castelino,
+            what: format!(
+                "{pairs} node-level precedence pairs after the transformation (at most \
+                 {CASTELINO_MAX_PRECEDENCE_PAIRS}): the precedence rules and pinned clusters join clusters with \
+                 many nodes"
+            ),
+        });
+    }
     let mut b = Problem::builder(t);
     for v in 0..2 * n {
         b.task(vec![Mode::point(StateId(v))]);
@@ -287,7 +315,7 @@ pub fn transformed_problem<'t, 'p, C: CostModel>(
         (0..k).flat_map(|i| [TaskId(base + i), TaskId(base + i + n)]).collect()
     };
     // Precedence by transitive reduction at task level: fewer node pairs, same order.
-    for (a, c) in reduced_precedence(p) {
+    for (a, c) in reduced {
         b.precede_groups(&nodes_of(a), &nodes_of(c));
     }
     for g in p.groups() {
@@ -331,11 +359,17 @@ pub fn transformed_problem<'t, 'p, C: CostModel>(
 }
 
 /// Task-level precedence pairs with transitively implied ones dropped.
-fn reduced_precedence<C: CostModel>(p: &Problem<C>) -> Vec<(TaskId, TaskId)> {
+fn reduced_precedence<C: CostModel>(p: &Problem<C>) -> Result<Vec<(TaskId, TaskId)>, BaselineError> {
     let n = p.num_tasks();
     let prec = p.precedence();
     if prec.num_edges() == 0 {
-        return Vec::new();
+        return Ok(Vec::new());
+    }
+    if n > REDUCE_MAX_TASKS {
+        return Err(BaselineError::TooLarge {
+            solver: crate::SolverName::Castelino,
+            what: format!("{n} clusters with precedence rules (the transformation reduces the rules of at most {REDUCE_MAX_TASKS})"),
+        });
     }
     let words = n.div_ceil(64);
     // reach[t]: tasks reachable from t by a path of one or more edges
@@ -362,7 +396,7 @@ fn reduced_precedence<C: CostModel>(p: &Problem<C>) -> Vec<(TaskId, TaskId)> {
             }
         }
     }
-    out
+    Ok(out)
 }
 
 /// Maps a route of the transformed problem back to a route of the GTSP (see the module docs).
@@ -415,7 +449,7 @@ pub fn solve_castelino<C: CostModel>(
     params: &CastelinoParams,
     opts: &SolveOptions,
 ) -> Result<SolveReport, BaselineError> {
-    let clock = Clock::new(opts);
+    let clock = Clock::for_options(opts);
     initial_cost(p, opts)?;
     let t = transform(p, params)?;
     // A closed tour without a start state needs an anchor when there is precedence: rotate it to
@@ -428,10 +462,11 @@ pub fn solve_castelino<C: CostModel>(
     let mut iterations = 0;
     let mut first = f64::INFINITY;
     let parts = pins.len() as u32;
-    for pin in pins {
+    for (k, pin) in pins.into_iter().enumerate() {
         let tp = transformed_problem(&t, pin)?;
         let mut inner = opts.clone();
-        inner.time_limit = opts.time_limit.map(|d| d / parts);
+        // What is left of the time limit, shared by the pins still to solve.
+        inner.time_limit = clock.remaining().map(|d| d / (parts - k as u32));
         inner.initial = opts
             .initial
             .as_ref()
@@ -627,7 +662,7 @@ mod tests {
         b.precede(TaskId(0), TaskId(3));
         b.end(End::Free);
         let p = b.build().unwrap();
-        let mut r = reduced_precedence(&p);
+        let mut r = reduced_precedence(&p).unwrap();
         r.sort();
         assert_eq!(r, vec![(TaskId(0), TaskId(1)), (TaskId(0), TaskId(3)), (TaskId(1), TaskId(2))]);
     }

@@ -1,33 +1,10 @@
-//! What every baseline shares: the clock (time limit and cancel flag) and the last step that
-//! checks the answer, keeps the initial route if it is better, and fills in the report.
+//! What every baseline shares: the last step that checks the answer, keeps the initial route if
+//! it is better, and fills in the report. The clock (time limit and cancel flag) is
+//! [`towpath_seq::Clock`], the same as towpath's solver's.
 
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
-use std::time::Instant;
-
-use towpath_seq::{check, CostModel, Problem, Solution, SolveOptions, SolveReport, Step};
+use towpath_seq::{check, Clock, CostModel, Problem, Solution, SolveOptions, SolveReport, Step};
 
 use crate::BaselineError;
-
-/// Wall time and cancellation for a run.
-pub(crate) struct Clock {
-    pub t0: Instant,
-    deadline: Option<Instant>,
-    cancel: Option<Arc<AtomicBool>>,
-}
-
-impl Clock {
-    pub fn new(opts: &SolveOptions) -> Self {
-        let t0 = Instant::now();
-        Clock { t0, deadline: opts.time_limit.map(|d| t0 + d), cancel: opts.cancel.clone() }
-    }
-
-    /// True once the time limit has passed or the run was cancelled.
-    pub fn expired(&self) -> bool {
-        self.deadline.is_some_and(|d| Instant::now() >= d)
-            || self.cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed))
-    }
-}
 
 /// Checks the initial route given in the options, if any, and returns its cost.
 pub(crate) fn initial_cost<C: CostModel>(
@@ -77,7 +54,7 @@ pub(crate) fn finish<C: CostModel>(
         initial_cost,
         first_local_optimum: first_cost,
         iterations,
-        elapsed: clock.t0.elapsed(),
+        elapsed: clock.elapsed(),
         exact: false,
     })
 }

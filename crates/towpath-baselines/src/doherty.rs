@@ -39,10 +39,14 @@
 //! and `k` "a function of the precedence set's ply count and the layup strategy" without giving
 //! the functions; ours are [`DohertyParams::max_depth`] and [`DohertyParams::breadth`].
 
-use towpath_seq::{CostModel, Problem, SolveOptions, SolveReport, StateId, Step, TaskId};
+use towpath_seq::{Clock, CostModel, Problem, SolveOptions, SolveReport, StateId, Step, TaskId};
 
-use crate::common::{finish, Clock};
+use crate::common::finish;
 use crate::BaselineError;
+
+/// Most moves one nearest-neighbour pass over the precedence sets may weigh (Σ tasks × modes of
+/// each set): the first pass is made in full whatever the time limit.
+pub const DOHERTY_MAX_PASS: u64 = 1_000_000_000;
 
 /// One precedence set: tasks that may be done in any order among themselves, and how many plies
 /// they came from (used by the depth and breadth rules).
@@ -170,6 +174,8 @@ struct SetSearch<'a, C> {
     tasks: &'a [TaskId],
     /// Tasks that may not be chosen by the search (the pinned last task, appended afterwards).
     barred: Option<TaskId>,
+    /// Once it expires, paths are finished by nearest neighbour (no lookahead).
+    clock: &'a Clock,
 }
 
 impl<C: CostModel> SetSearch<'_, C> {
@@ -245,7 +251,7 @@ impl<C: CostModel> SetSearch<'_, C> {
         }
         while out.len() < todo {
             let mut best: Option<(f64, f64, usize, usize)> = None;
-            if depth <= 1 {
+            if depth <= 1 || self.clock.expired() {
                 if let Some((i, m, c)) = self.nearest(Some(cur), &visited) {
                     best = Some((c, c, i, m));
                 }
@@ -319,7 +325,7 @@ pub fn solve_doherty_traced<C: CostModel>(
     params: &DohertyParams,
     opts: &SolveOptions,
 ) -> Result<(SolveReport, Vec<SetTrace>), BaselineError> {
-    let clock = Clock::new(opts);
+    let clock = Clock::for_options(opts);
     if !p.groups().is_empty() {
         return Err(BaselineError::Unsupported {
             solver: crate::SolverName::Doherty,
@@ -331,6 +337,21 @@ pub fn solve_doherty_traced<C: CostModel>(
         None => sets_from_precedence(p),
     };
     validate_sets(p, &sets)?;
+    // The first nearest-neighbour path of every set is made whatever the time limit: refuse
+    // sets too large for it (each step weighs every mode of the set).
+    let pass: u64 = sets
+        .iter()
+        .map(|set| set.tasks.len() as u64 * set.tasks.iter().map(|&t| p.modes(t).len() as u64).sum::<u64>())
+        .sum();
+    if pass > DOHERTY_MAX_PASS {
+        return Err(BaselineError::TooLarge {
+            solver: crate::SolverName::Doherty,
+            what: format!(
+                "one nearest-neighbour pass over the precedence sets weighs {pass} moves, the seed pool at most \
+                 {DOHERTY_MAX_PASS}"
+            ),
+        });
+    }
     let mut steps: Vec<Step> = Vec::with_capacity(p.num_tasks());
     let mut traces = Vec::new();
     let mut iterations = 0u64;
@@ -341,7 +362,7 @@ pub fn solve_doherty_traced<C: CostModel>(
             continue;
         }
         let barred = p.last_task().filter(|_| Some(k) == last_nonempty && set.tasks.len() > 1);
-        let search = SetSearch { p, tasks: &set.tasks, barred };
+        let search = SetSearch { p, tasks: &set.tasks, barred, clock: &clock };
         let bidirectional = set.tasks.iter().any(|&t| p.modes(t).len() > 1);
         let courses = set.tasks.len() - usize::from(barred.is_some());
         // 1–2: seed pool, nearest neighbour from each seed, the cheapest path's seed kept.

@@ -44,9 +44,9 @@
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
-use towpath_seq::{CostModel, Problem, SolveOptions, SolveReport, Step, TaskId};
+use towpath_seq::{Clock, CostModel, Problem, SolveOptions, SolveReport, Step, TaskId};
 
-use crate::common::{finish, Clock};
+use crate::common::finish;
 use crate::order::OrderBuilder;
 use crate::BaselineError;
 
@@ -89,19 +89,68 @@ impl GaParams {
         GaParams { population: 200, generations: 1000, ..GaParams::default() }
     }
 
-    fn validate(&self) -> Result<(), BaselineError> {
+    /// Checks the parameters, and the memory a population of individuals of `n` tasks takes.
+    fn validate(&self, n: usize) -> Result<(), BaselineError> {
         if self.population < 2 {
             return Err(BaselineError::BadParams("GA population must be at least 2".into()));
         }
         for (name, v) in [("crossover rate", self.crossover_rate), ("mutation rate", self.mutation_rate)] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(BaselineError::BadParams(format!("GA {name} must be a number ≥ 0, not {v}")));
+            if !(v.is_finite() && (0.0..=GA_MAX_RATE).contains(&v)) {
+                return Err(BaselineError::BadParams(format!(
+                    "GA {name} must be a number from 0 to {GA_MAX_RATE} (a fraction of P_size per generation), not {v}"
+                )));
             }
         }
         if self.parent_pairs == 0 {
             return Err(BaselineError::BadParams("GA needs at least one parent pair to sample".into()));
         }
+        // P_total = P_size + x_rate · P_size individuals, each an order and its genes.
+        let individual = INDIVIDUAL_BYTES + 8.0 * n as f64;
+        let total = self.population as f64 * (1.0 + self.crossover_rate);
+        let bytes = total * individual;
+        if bytes > GA_MAX_BYTES as f64 {
+            let most = (GA_MAX_BYTES as f64 / individual / (1.0 + self.crossover_rate)).floor().max(2.0);
+            return Err(BaselineError::TooMuch {
+                param: "ga.population",
+                message: format!(
+                    "a GA population of {} on {n} tasks keeps {total:.3e} individuals of {individual} bytes ({}); \
+                     at most {} of memory, a population of up to {most:.0} here",
+                    self.population,
+                    human_bytes(bytes),
+                    human_bytes(GA_MAX_BYTES as f64)
+                ),
+            });
+        }
         Ok(())
+    }
+}
+
+/// Most memory the GA's population may take.
+pub const GA_MAX_BYTES: u64 = 1 << 30;
+
+/// Largest crossover or mutation rate (children or mutations per generation, as a fraction of
+/// `P_size`).
+pub const GA_MAX_RATE: f64 = 100.0;
+
+/// Most steps the first two chromosomes' decoding may take.
+const GA_MAX_DECODE: u64 = 1_000_000_000;
+
+/// Memory of an individual besides its `8 n` bytes of order and genes.
+const INDIVIDUAL_BYTES: f64 = 64.0;
+
+/// A byte count for messages: `2.1 TB`, `512 MB`.
+pub(crate) fn human_bytes(b: f64) -> String {
+    let units = ["bytes", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut v = b;
+    let mut k = 0;
+    while v >= 1000.0 && k + 1 < units.len() {
+        v /= 1000.0;
+        k += 1;
+    }
+    if k == 0 {
+        format!("{v:.0} {}", units[k])
+    } else {
+        format!("{v:.1} {}", units[k])
     }
 }
 
@@ -185,9 +234,22 @@ pub fn solve_ga<C: CostModel>(
     params: &GaParams,
     opts: &SolveOptions,
 ) -> Result<SolveReport, BaselineError> {
-    params.validate()?;
-    let clock = Clock::new(opts);
     let n = p.num_tasks();
+    params.validate(n)?;
+    // Decoding a chromosome under precedence, groups or pins scans the order for each step;
+    // the first two individuals are made whatever the time limit.
+    if !OrderBuilder::new(p).is_free() && 2 * (n as u64).pow(2) > GA_MAX_DECODE {
+        return Err(BaselineError::TooLarge {
+            solver: crate::SolverName::Ga,
+            what: format!(
+                "{n} tasks under precedence, groups or pins: decoding a chromosome weighs n² = {} steps, the GA \
+                 at most {}",
+                (n as u64).pow(2),
+                GA_MAX_DECODE / 2
+            ),
+        });
+    }
+    let clock = Clock::for_options(opts);
     let max_modes = p.max_modes().max(1) as u32;
     let flip = |g: u32| (g + 1) % max_modes;
     let mut rng = Pcg64Mcg::seed_from_u64(opts.seed ^ 0x6A_5EED_0004);
@@ -205,18 +267,22 @@ pub fn solve_ga<C: CostModel>(
             f64::INFINITY
         }
     };
-    let psize = params.population;
-    let mut pop: Vec<Individual> = (0..psize)
-        .map(|_| {
-            let mut order: Vec<u32> = (0..n as u32).collect();
-            for i in (1..n).rev() {
-                order.swap(i, rng.gen_range(0..=i));
-            }
-            let genes: Vec<u32> = (0..n).map(|_| rng.gen_range(0..max_modes)).collect();
-            let cost = eval(&order, &genes, &mut steps);
-            Individual { order, genes, cost }
-        })
-        .collect();
+    let total = params.population + (params.crossover_rate * params.population as f64).round() as usize;
+    let mut pop: Vec<Individual> = Vec::with_capacity(total);
+    for _ in 0..params.population {
+        // The time limit may cut the first population short (never below two individuals).
+        if pop.len() >= 2 && clock.expired() {
+            break;
+        }
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        for i in (1..n).rev() {
+            order.swap(i, rng.gen_range(0..=i));
+        }
+        let genes: Vec<u32> = (0..n).map(|_| rng.gen_range(0..max_modes)).collect();
+        let cost = eval(&order, &genes, &mut steps);
+        pop.push(Individual { order, genes, cost });
+    }
+    let psize = pop.len();
     let by_cost = |a: &Individual, b: &Individual| a.cost.total_cmp(&b.cost);
     pop.sort_by(by_cost);
     let mut best = pop[0].clone();
@@ -230,7 +296,7 @@ pub fn solve_ga<C: CostModel>(
         }
         generations += 1;
         let mut made = 0;
-        while made < children && n > 0 {
+        while made < children && n > 0 && !clock.expired() {
             // parents: the best of `parent_pairs` random pairs
             let mut pair = two_distinct(&mut rng, psize);
             let mut pair_cost = pop[pair.0].cost + pop[pair.1].cost;
@@ -262,6 +328,9 @@ pub fn solve_ga<C: CostModel>(
             }
         }
         for _ in 0..mutations {
+            if clock.expired() {
+                break;
+            }
             let k = rng.gen_range(0..pop.len());
             mutate(&mut pop[k], &mut rng, flip);
             let ind = &pop[k];

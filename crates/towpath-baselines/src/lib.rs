@@ -37,11 +37,14 @@ mod generate;
 mod order;
 mod registry;
 
-pub use aco::{solve_aco, update_trails, AcoParams, ACO_MAX_STATES};
+pub use aco::{solve_aco, update_trails, AcoParams, ACO_MAX_ANTS_PER_TASK, ACO_MAX_STATES, ACO_MAX_WALK};
 pub use castelino::{
     lift, map_back, solve_castelino, transform, transformed_problem, CastelinoParams, Transformed, CASTELINO_MAX_NODES,
+    CASTELINO_MAX_PRECEDENCE_PAIRS,
 };
-pub use doherty::{sets_from_precedence, solve_doherty, solve_doherty_traced, DohertyParams, PrecedenceSet, SetTrace};
-pub use ga::{bit_crossover, order_crossover, solve_ga, GaParams};
+pub use doherty::{
+    sets_from_precedence, solve_doherty, solve_doherty_traced, DohertyParams, PrecedenceSet, SetTrace, DOHERTY_MAX_PASS,
+};
+pub use ga::{bit_crossover, order_crossover, solve_ga, GaParams, GA_MAX_BYTES, GA_MAX_RATE};
 pub use generate::random_gtsp;
 pub use registry::{solve_with, BaselineError, BaselineParams, SolverName};

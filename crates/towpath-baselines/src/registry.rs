@@ -14,15 +14,15 @@ pub enum SolverName {
     /// towpath's own solver (`towpath_seq::solve`): the default.
     #[default]
     Towpath,
-    /// Seed 000 §3.2: seed pool + nearest neighbour, depth-first and breadth-first search.
+    /// Doherty et al. (2022) §3.2: seed pool + nearest neighbour, depth-first and breadth-first search.
     Doherty,
-    /// Seed 003: GTSP → ATSP (2n) transformation, solved by towpath's SOP/TSP search.
+    /// Castelino et al. (2003): GTSP → ATSP (2n) transformation, solved by towpath's SOP/TSP search.
     Castelino,
-    /// Seed 004 §IV: the genetic algorithm.
+    /// Tewolde & Sheng (2008) §IV: the genetic algorithm.
     Ga,
-    /// Seed 004 §V: the ant system with one ant per required edge.
+    /// Tewolde & Sheng (2008) §V: the ant system with one ant per required edge.
     Aco1,
-    /// Seed 004 §V: the ant system with two ants per required edge (one at each end).
+    /// Tewolde & Sheng (2008) §V: the ant system with two ants per required edge (one at each end).
     #[cfg_attr(feature = "clap", value(alias = "aco"))]
     Aco2,
 }
@@ -62,10 +62,10 @@ impl SolverName {
     pub fn reference(self) -> &'static str {
         match self {
             SolverName::Towpath => "towpath's own solver",
-            SolverName::Doherty => "seed 000 §3.2 (Doherty et al. 2022)",
-            SolverName::Castelino => "seed 003 §5 (Castelino et al. 2003)",
-            SolverName::Ga => "seed 004 §IV (Tewolde & Sheng 2008)",
-            SolverName::Aco1 | SolverName::Aco2 => "seed 004 §V (Tewolde & Sheng 2008)",
+            SolverName::Doherty => "Doherty et al. 2022, §3.2",
+            SolverName::Castelino => "Castelino et al. 2003, §5",
+            SolverName::Ga => "Tewolde & Sheng 2008, §IV",
+            SolverName::Aco1 | SolverName::Aco2 => "Tewolde & Sheng 2008, §V",
         }
     }
 }
@@ -96,13 +96,13 @@ impl FromStr for SolverName {
 /// The parameters of every baseline; each solver reads its own part.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BaselineParams {
-    /// Seed 000 solver.
+    /// Doherty et al.'s (2022) solver.
     pub doherty: DohertyParams,
-    /// Seed 003 transformation.
+    /// Castelino et al.'s (2003) transformation.
     pub castelino: CastelinoParams,
-    /// Seed 004 GA.
+    /// Tewolde & Sheng's (2008) GA.
     pub ga: GaParams,
-    /// Seed 004 ant system; `ants_per_task` is set by the choice of `aco1` or `aco2`.
+    /// Tewolde & Sheng's (2008) ant system; `ants_per_task` is set by the choice of `aco1` or `aco2`.
     pub aco: AcoParams,
 }
 
@@ -140,6 +140,14 @@ pub enum BaselineError {
     /// A parameter is out of range.
     #[error("bad parameter: {0}")]
     BadParams(String),
+    /// A parameter asks for more memory or work than the solver takes on.
+    #[error("{message}")]
+    TooMuch {
+        /// The parameter, as a field path of [`BaselineParams`] (`ga.population`).
+        param: &'static str,
+        /// What it would take and what is allowed.
+        message: String,
+    },
 }
 
 /// Solves `problem` with the named solver.

@@ -2,6 +2,8 @@
 //! have coordinates and whose edges have lengths, a subset of *required* edges that the tool must
 //! traverse, and optionally the vertex the tool starts from.
 
+use towpath_seq::MAX_ROUTE_COST;
+
 use crate::paths::connected_components;
 
 /// One edge of the travel graph.
@@ -75,6 +77,17 @@ pub enum InstanceErrorKind {
     /// The start vertex cannot reach a required edge.
     #[error("the start vertex cannot reach required edge {0}: the graph is not connected")]
     StartDisconnected(usize),
+    /// The edges are so long that route lengths could not be added up.
+    #[error(
+        "the edges' lengths add up to {total:e}: a route serving {required} required edges could be longer than \
+         the {MAX_ROUTE_COST:e} towpath adds up; scale the lengths down"
+    )]
+    TooLong {
+        /// The sum of every edge's length.
+        total: f64,
+        /// Required edges.
+        required: usize,
+    },
 }
 
 /// A validation error: what is wrong and where.
@@ -139,6 +152,15 @@ impl Instance {
         let Some(&first) = required.first() else {
             return Err(InstanceError { item: Item::Whole, kind: InstanceErrorKind::NothingRequired });
         };
+        // A route is the required edges and a shortest path before each: at most
+        // (required + 1) times every edge.
+        let total: f64 = edges.iter().map(|e| e.length).sum();
+        if total * (required.len() + 1) as f64 > MAX_ROUTE_COST {
+            return Err(InstanceError {
+                item: Item::Whole,
+                kind: InstanceErrorKind::TooLong { total, required: required.len() },
+            });
+        }
         let comp = connected_components(nv, &edges);
         let c0 = comp[edges[first as usize].a as usize];
         for &r in &required {
@@ -218,5 +240,8 @@ mod tests {
         assert_eq!(err.item, Item::Edge(1));
         let err = Instance::new(None, v, vec![e(0, 1, 1.0)], &[true], Some(2)).unwrap_err();
         assert_eq!(err.item, Item::Start);
+        // Lengths a route could not add up.
+        let err = Instance::new(None, vec![[0.0; 3]; 2], vec![e(0, 1, 1e300)], &[true], None).unwrap_err();
+        assert!(matches!(err.kind, InstanceErrorKind::TooLong { required: 1, .. }), "{err}");
     }
 }

@@ -27,8 +27,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::instance::{Edge, Instance, InstanceErrorKind, Item};
-use crate::locate::{locate, Seg};
 use crate::model::Route;
+use towpath_formats::json_locate::{locate, Seg};
 
 /// The value of the optional `format` field.
 pub const FORMAT: &str = "towpath-rpp/1";

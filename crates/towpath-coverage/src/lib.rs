@@ -24,12 +24,13 @@
 mod generate;
 mod instance;
 mod json;
-mod locate;
 mod model;
 mod paths;
 
-pub use generate::{seed004_like, TABLE_I_SIZES};
+pub use generate::{seed004_like, GenerateError, MAX_GENERATED_REQUIRED, TABLE_I_SIZES};
 pub use instance::{Edge, Instance, InstanceError, InstanceErrorKind, Item};
 pub use json::{read_instance, write_instance, ReadError, ReadErrorKind, RouteJson, ServiceJson, FORMAT, ROUTE_FORMAT};
-pub use model::{verify_route, PathCost, Route, RouteError, RppModel, Service};
-pub use paths::{PathAlgorithm, ShortestPaths, FLOYD_WARSHALL_MAX_VERTICES, NO_EDGE};
+pub use model::{
+    model_bytes, verify_route, BuildError, PathCost, Route, RouteError, RppModel, Service, MODEL_MAX_BYTES,
+};
+pub use paths::{PathAlgorithm, ShortestPaths, Stopped, FLOYD_WARSHALL_MAX_VERTICES, NO_EDGE};

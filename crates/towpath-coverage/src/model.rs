@@ -18,10 +18,62 @@
 //! [`RppModel::route`] expands a solution back into the full walk through the graph, and
 //! [`verify_route`] checks such a walk against the instance without using the model.
 
-use towpath_seq::{CostModel, End, Mode, ModelError, Problem, StateId, Step, TaskId};
+use towpath_seq::{Clock, CostModel, End, Mode, ModelError, Problem, StateId, Step, TaskId};
 
 use crate::instance::Instance;
-use crate::paths::ShortestPaths;
+use crate::paths::{ShortestPaths, Stopped, FLOYD_WARSHALL_MAX_VERTICES};
+
+/// Most memory the model's tables may take: shortest-path trees and distances from every
+/// terminal to every vertex (12 bytes a pair), the terminals' distance matrix (8 bytes a pair)
+/// and, on small graphs, the Floyd–Warshall tables.
+pub const MODEL_MAX_BYTES: u64 = 1 << 31;
+
+/// The memory [`RppModel`] takes for its tables on a graph of `vertices` vertices with
+/// `terminals` terminals (see [`MODEL_MAX_BYTES`]).
+pub fn model_bytes(vertices: usize, terminals: usize) -> u64 {
+    let (v, t) = (vertices as u64, terminals as u64);
+    let floyd = if vertices <= FLOYD_WARSHALL_MAX_VERTICES { 12 * v * v } else { 0 };
+    12u64.saturating_mul(t).saturating_mul(v).saturating_add(8u64.saturating_mul(t).saturating_mul(t)) + floyd
+}
+
+/// Why an instance could not be turned into a sequencing problem.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum BuildError {
+    /// The instance is too large for the model's tables.
+    #[error(
+        "{terminals} terminals (ends of required edges) over {vertices} vertices need {} of shortest-path \
+         tables; towpath takes at most {}",
+        gigabytes(*bytes),
+        gigabytes(MODEL_MAX_BYTES)
+    )]
+    TooLarge {
+        /// Terminals of the instance.
+        terminals: usize,
+        /// Vertices of the travel graph.
+        vertices: usize,
+        /// Bytes the tables would take.
+        bytes: u64,
+    },
+    /// The shortest paths were not done within the time limit (or the run was cancelled).
+    #[error(
+        "{}the shortest paths between the {} terminals were not done within the time limit: {} of {} searches in \
+         {:.2} s, about {:.1} s for all of them",
+        if .0.cancelled { "cancelled: " } else { "" },
+        .0.total,
+        .0.done,
+        .0.total,
+        .0.seconds,
+        .0.estimate
+    )]
+    OutOfTime(Stopped),
+    /// The sequencing model refused the problem.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+}
+
+fn gigabytes(b: u64) -> String {
+    format!("{:.2} GB", b as f64 / 1e9)
+}
 
 /// Shortest-path distances between terminals: the cost model of the open rural postman problem.
 #[derive(Clone, Debug)]
@@ -44,6 +96,9 @@ impl CostModel for PathCost {
     }
     fn position(&self, state: StateId) -> Option<[f64; 3]> {
         self.positions.get(state.index()).copied()
+    }
+    fn cost_bound(&self) -> Option<f64> {
+        Some(self.dist.iter().filter(|d| d.is_finite()).fold(0.0, |m: f64, d| m.max(d.abs())))
     }
 }
 
@@ -123,8 +178,17 @@ pub struct RppModel {
 }
 
 impl RppModel {
-    /// Computes shortest paths between terminals and builds the problem.
-    pub fn new(instance: Instance) -> Result<Self, ModelError> {
+    /// Computes shortest paths between terminals (on all cores, without a time limit) and builds
+    /// the problem.
+    pub fn new(instance: Instance) -> Result<Self, BuildError> {
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        Self::build(instance, &Clock::unlimited(), threads)
+    }
+
+    /// Builds the model within the clock's time limit, on up to `threads` threads. Refuses
+    /// before allocating when its tables would exceed [`MODEL_MAX_BYTES`], and stops when the
+    /// shortest paths cannot be done in the time left.
+    pub fn build(instance: Instance, clock: &Clock, threads: usize) -> Result<Self, BuildError> {
         let edges = instance.edges();
         let mut terminals: Vec<u32> = Vec::new();
         let mut state_of = vec![u32::MAX; instance.vertices().len()];
@@ -143,7 +207,13 @@ impl RppModel {
             let b = add(e.b, &mut terminals);
             task_states.push((a, b, e.length));
         }
-        let paths = ShortestPaths::compute(instance.vertices().len(), edges, &terminals);
+        let vertices = instance.vertices().len();
+        let bytes = model_bytes(vertices, terminals.len());
+        if bytes > MODEL_MAX_BYTES {
+            return Err(BuildError::TooLarge { terminals: terminals.len(), vertices, bytes });
+        }
+        let paths = ShortestPaths::compute_within(vertices, edges, &terminals, clock, threads)
+            .map_err(BuildError::OutOfTime)?;
         let t = terminals.len();
         let mut dist = vec![0.0; t * t];
         for i in 0..t {
@@ -334,6 +404,56 @@ mod tests {
         let mut r = good;
         r.services[0].position = 1;
         assert!(matches!(verify_route(m.instance(), &r), Err(RouteError::ServiceMismatch(0))));
+    }
+
+    /// A path graph of `2r` vertices whose every other edge is required: 2r terminals.
+    fn ladder(r: usize) -> Instance {
+        let v: Vec<[f64; 3]> = (0..2 * r).map(|i| [i as f64, 0.0, 0.0]).collect();
+        let edges: Vec<Edge> = (0..2 * r as u32 - 1).map(|i| Edge { a: i, b: i + 1, length: 1.0 }).collect();
+        let req: Vec<bool> = (0..edges.len()).map(|i| i % 2 == 0).collect();
+        Instance::new(None, v, edges, &req, None).unwrap()
+    }
+
+    #[test]
+    fn tables_too_large_are_refused_before_they_are_made() {
+        // 12,000 terminals over 12,000 vertices: 12·t·V + 8·t² = 2.9 GB.
+        let e = RppModel::new(ladder(6000)).unwrap_err();
+        let BuildError::TooLarge { terminals, vertices, bytes } = e.clone() else { panic!("{e}") };
+        assert_eq!((terminals, vertices), (12_000, 12_000));
+        assert_eq!(bytes, 12 * 12_000 * 12_000 + 8 * 12_000 * 12_000);
+        assert!(e.to_string().contains("2.88 GB"), "{e}");
+        // Within the budget it builds, and the bound is what the tables take.
+        let m = RppModel::new(ladder(400)).unwrap();
+        let t = m.problem().cost_model().num_states() as u64;
+        assert_eq!(model_bytes(800, t as usize), 12 * t * 800 + 8 * t * t);
+    }
+
+    #[test]
+    fn shortest_paths_stop_at_the_time_limit_and_say_what_they_need() {
+        let i = crate::seed004_like(600, 1).unwrap();
+        // No time at all: stopped after the first search of each thread.
+        let clock = Clock::start(Some(std::time::Duration::ZERO), None);
+        let e = RppModel::build(i.clone(), &clock, 2).unwrap_err();
+        let BuildError::OutOfTime(stop) = &e else { panic!("{e}") };
+        assert!(stop.done < stop.total && stop.total == 1200 && !stop.cancelled, "{e}");
+        assert!(e.to_string().contains("of 1200 searches"), "{e}");
+        // Cancelled.
+        let flag = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
+        let e = RppModel::build(i.clone(), &Clock::start(None, Some(flag)), 1).unwrap_err();
+        assert!(matches!(&e, BuildError::OutOfTime(s) if s.cancelled), "{e}");
+        // With time enough, the same model on any number of threads.
+        let a = RppModel::build(i.clone(), &Clock::start(Some(std::time::Duration::from_secs(600)), None), 1).unwrap();
+        let b = RppModel::build(i, &Clock::unlimited(), 3).unwrap();
+        assert_eq!(a.paths().sources(), b.paths().sources());
+        let n = a.problem().cost_model().num_states() as u32;
+        for x in (0..n).step_by(97) {
+            for y in (0..n).step_by(89) {
+                assert_eq!(
+                    a.problem().transition(StateId(x), StateId(y)),
+                    b.problem().transition(StateId(x), StateId(y))
+                );
+            }
+        }
     }
 
     #[test]

@@ -3,8 +3,12 @@
 //! each source, a shortest-path tree (the edge by which each vertex is reached) so connecting
 //! paths can be written out vertex by vertex.
 
-use std::cmp::Ordering;
+use std::cmp;
 use std::collections::BinaryHeap;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::Instant;
+
+use towpath_seq::Clock;
 
 use crate::instance::Edge;
 
@@ -19,6 +23,22 @@ pub enum PathAlgorithm {
     FloydWarshall,
     /// One Dijkstra search per source.
     Dijkstra,
+}
+
+/// Shortest-path searches stopped before they were all done: by the clock, or because they
+/// were seen to need more time than was left.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stopped {
+    /// Searches done (one per source).
+    pub done: usize,
+    /// Searches needed.
+    pub total: usize,
+    /// Seconds spent.
+    pub seconds: f64,
+    /// Seconds all of them would take, projected from those done.
+    pub estimate: f64,
+    /// True when the run was cancelled rather than out of time.
+    pub cancelled: bool,
 }
 
 /// Marks "no edge" in a shortest-path tree (the source itself, or unreachable).
@@ -119,29 +139,72 @@ impl ShortestPaths {
         let n = num_vertices;
         let adj = adjacency(n, edges);
         let mut sp = Self::empty(n, sources, PathAlgorithm::Dijkstra);
-        let mut heap = BinaryHeap::new();
-        for r in 0..sp.sources.len() {
-            let s = sp.sources[r] as usize;
-            let dist = &mut sp.dist[r * n..(r + 1) * n];
-            let pred = &mut sp.pred[r * n..(r + 1) * n];
-            dist[s] = 0.0;
-            heap.clear();
-            heap.push(Entry { d: 0.0, v: s as u32 });
-            while let Some(Entry { d, v }) = heap.pop() {
-                if d > dist[v as usize] {
-                    continue;
-                }
-                for &(w, k) in &adj[v as usize] {
-                    let nd = d + edges[k as usize].length;
-                    if nd < dist[w as usize] {
-                        dist[w as usize] = nd;
-                        pred[w as usize] = k;
-                        heap.push(Entry { d: nd, v: w });
-                    }
+        let srcs = sp.sources.clone();
+        search_rows(&adj, n, &srcs, &mut sp.dist, &mut sp.pred, &|| true);
+        sp
+    }
+
+    /// Computes shortest paths like [`ShortestPaths::compute`], on up to `threads` threads, within
+    /// the clock's time limit. The searches stop when the clock expires, or as soon as they are
+    /// seen to need more than the time that was left when they began (projected from the searches
+    /// done, once a twentieth of them or of that time has gone by).
+    pub fn compute_within(
+        num_vertices: usize,
+        edges: &[Edge],
+        sources: &[u32],
+        clock: &Clock,
+        threads: usize,
+    ) -> Result<Self, Stopped> {
+        if num_vertices <= FLOYD_WARSHALL_MAX_VERTICES {
+            return Ok(Self::floyd_warshall(num_vertices, edges, sources));
+        }
+        let n = num_vertices;
+        let adj = adjacency(n, edges);
+        let mut sp = Self::empty(n, sources, PathAlgorithm::Dijkstra);
+        let rows = sp.sources.len();
+        if rows == 0 || n == 0 {
+            return Ok(sp);
+        }
+        let t0 = Instant::now();
+        let left = clock.remaining();
+        let done = AtomicUsize::new(0);
+        let stop = AtomicBool::new(false);
+        // After each search: stop on the clock, or when the searches will not fit the time left.
+        let keep_going = || {
+            let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
+            if clock.expired() {
+                stop.store(true, Ordering::Relaxed);
+            } else if let Some(left) = left {
+                let spent = t0.elapsed();
+                if (finished * 20 >= rows || spent * 20 >= left)
+                    && spent.as_secs_f64() * rows as f64 / finished as f64 > left.as_secs_f64()
+                {
+                    stop.store(true, Ordering::Relaxed);
                 }
             }
+            !stop.load(Ordering::Relaxed)
+        };
+        let per = rows.div_ceil(threads.clamp(1, rows));
+        let srcs = sp.sources.clone();
+        let parts = sp.dist.chunks_mut(per * n).zip(sp.pred.chunks_mut(per * n)).zip(srcs.chunks(per));
+        std::thread::scope(|scope| {
+            for ((dist, pred), part) in parts {
+                let (adj, keep_going) = (&adj, &keep_going);
+                scope.spawn(move || search_rows(adj, n, part, dist, pred, keep_going));
+            }
+        });
+        if stop.load(Ordering::Relaxed) {
+            let finished = done.load(Ordering::Relaxed).min(rows);
+            let seconds = t0.elapsed().as_secs_f64();
+            return Err(Stopped {
+                done: finished,
+                total: rows,
+                seconds,
+                estimate: seconds * rows as f64 / finished.max(1) as f64,
+                cancelled: clock.cancelled(),
+            });
         }
-        sp
+        Ok(sp)
     }
 
     /// The algorithm that computed these paths.
@@ -199,28 +262,86 @@ struct Entry {
 impl Eq for Entry {}
 
 impl Ord for Entry {
-    fn cmp(&self, other: &Self) -> Ordering {
+    fn cmp(&self, other: &Self) -> cmp::Ordering {
         // min-heap on distance, ties by vertex for determinism
         other.d.total_cmp(&self.d).then_with(|| other.v.cmp(&self.v))
     }
 }
 
 impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+    fn partial_cmp(&self, other: &Self) -> Option<cmp::Ordering> {
         Some(self.cmp(other))
     }
 }
 
-/// Adjacency lists: for each vertex, (neighbour, edge index), loops left out.
-pub(crate) fn adjacency(n: usize, edges: &[Edge]) -> Vec<Vec<(u32, u32)>> {
-    let mut adj = vec![Vec::new(); n];
-    for (k, e) in edges.iter().enumerate() {
-        if e.a != e.b {
-            adj[e.a as usize].push((e.b, k as u32));
-            adj[e.b as usize].push((e.a, k as u32));
+/// One Dijkstra search per source, row after row of `dist` and `pred` (`n` entries each), as
+/// long as `keep_going` (asked after each search) says so.
+fn search_rows(
+    adj: &Adjacency,
+    n: usize,
+    sources: &[u32],
+    dist: &mut [f64],
+    pred: &mut [u32],
+    keep_going: &(dyn Fn() -> bool + Sync),
+) {
+    let mut heap = BinaryHeap::new();
+    for ((&s, dist), pred) in sources.iter().zip(dist.chunks_mut(n)).zip(pred.chunks_mut(n)) {
+        let s = s as usize;
+        dist[s] = 0.0;
+        heap.clear();
+        heap.push(Entry { d: 0.0, v: s as u32 });
+        while let Some(Entry { d, v }) = heap.pop() {
+            if d > dist[v as usize] {
+                continue;
+            }
+            for &(w, k, length) in adj.of(v) {
+                let nd = d + length;
+                if nd < dist[w as usize] {
+                    dist[w as usize] = nd;
+                    pred[w as usize] = k;
+                    heap.push(Entry { d: nd, v: w });
+                }
+            }
+        }
+        if !keep_going() {
+            return;
         }
     }
-    adj
+}
+
+/// Adjacency lists in one array (loops left out): the neighbours of `v` are
+/// `arcs[start[v]..start[v + 1]]`, each `(neighbour, edge index, length)`.
+pub(crate) struct Adjacency {
+    start: Vec<usize>,
+    arcs: Vec<(u32, u32, f64)>,
+}
+
+impl Adjacency {
+    #[inline]
+    fn of(&self, v: u32) -> &[(u32, u32, f64)] {
+        &self.arcs[self.start[v as usize]..self.start[v as usize + 1]]
+    }
+}
+
+/// The adjacency of an undirected graph, each vertex's arcs in edge order.
+pub(crate) fn adjacency(n: usize, edges: &[Edge]) -> Adjacency {
+    let mut start = vec![0usize; n + 1];
+    for e in edges.iter().filter(|e| e.a != e.b) {
+        start[e.a as usize + 1] += 1;
+        start[e.b as usize + 1] += 1;
+    }
+    for v in 0..n {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start.clone();
+    let mut arcs = vec![(0u32, 0u32, 0.0f64); start[n]];
+    for (k, e) in edges.iter().enumerate().filter(|(_, e)| e.a != e.b) {
+        arcs[fill[e.a as usize]] = (e.b, k as u32, e.length);
+        fill[e.a as usize] += 1;
+        arcs[fill[e.b as usize]] = (e.a, k as u32, e.length);
+        fill[e.b as usize] += 1;
+    }
+    Adjacency { start, arcs }
 }
 
 /// Connected component label of each vertex.

@@ -117,6 +117,31 @@ pub enum ErrorKind {
         /// What was expected.
         expected: String,
     },
+    /// A count is larger than towpath reads.
+    #[error("{key} {value} is too large: towpath reads at most {max}")]
+    TooLarge {
+        /// The keyword.
+        key: String,
+        /// The value given.
+        value: String,
+        /// The largest value read.
+        max: u64,
+    },
+    /// Integer costs so large that a route's cost would not add up exactly.
+    #[error(
+        "{what}: a route of {moves} moves could cost up to {bound:e}, beyond 2^53 ≈ 9.0e15 where integer costs \
+         stop adding up exactly; scale the {scale} down"
+    )]
+    InexactCosts {
+        /// Where the large costs come from (the nodes, or the matrix entry).
+        what: String,
+        /// Moves of a route.
+        moves: usize,
+        /// The bound on a route's cost.
+        bound: f64,
+        /// What to scale: coordinates or matrix entries.
+        scale: String,
+    },
     /// A token that should be a number is not one.
     #[error("`{0}` is not a number")]
     NotANumber(String),

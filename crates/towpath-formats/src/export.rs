@@ -19,13 +19,47 @@ pub enum CostsAs {
     Matrix,
 }
 
+/// The most entries [`Instance::to_json`] writes as a matrix computed from points (about 45
+/// bytes each in memory and pretty-printed text: a 5000-node instance).
+pub const MAX_MATRIX_ENTRIES: u64 = 25_000_000;
+
+/// An instance [`Instance::to_json`] does not write.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ExportError {
+    /// The matrix of a coordinate instance would be too large.
+    #[error(
+        "a matrix of {states} × {states} = {entries} costs is too large to write (at most {MAX_MATRIX_ENTRIES}, a \
+         {side}-node instance); write the points and their metric instead"
+    )]
+    MatrixTooLarge {
+        /// States of the instance.
+        states: usize,
+        /// Entries the matrix would have.
+        entries: u64,
+        /// The largest number of states written as a matrix.
+        side: u64,
+    },
+}
+
 impl Instance {
     /// The instance as a [`JsonProblem`]: the same states, costs, tasks and modes (in the same
     /// order), precedence, consecutive groups, pins and ends, so that every route has the same
     /// feasibility and cost in both. Task ids are the file's node numbers (`"1"`, `"2"`, …) for
     /// TSP/ATSP/SOP, `"set1"`, `"set2"`, … for GTSP/PCGTSP (a mode's `entry` is then its node
     /// number minus one), and the original ids for JSON problems.
-    pub fn to_json(&self, costs: CostsAs) -> JsonProblem {
+    ///
+    /// A coordinate instance written as a matrix ([`CostsAs::Matrix`]) is refused above
+    /// [`MAX_MATRIX_ENTRIES`]: its n² costs are not bounded by the file's size. (An explicit matrix
+    /// is written as read.)
+    pub fn to_json(&self, costs: CostsAs) -> Result<JsonProblem, ExportError> {
+        if let (LoadedProblem::Points(p), CostsAs::Matrix) = (&self.problem, costs) {
+            let states = p.cost_model().num_states();
+            let entries = (states as u64).saturating_mul(states as u64);
+            if entries > MAX_MATRIX_ENTRIES {
+                let side = (MAX_MATRIX_ENTRIES as f64).sqrt() as u64;
+                return Err(ExportError::MatrixTooLarge { states, entries, side });
+            }
+        }
         let ids = self.task_ids();
         let states = match (&self.problem, costs) {
             (LoadedProblem::Points(p), CostsAs::Native) => {
@@ -41,7 +75,7 @@ impl Instance {
             (LoadedProblem::Points(p), CostsAs::Matrix) => matrix_states(p.cost_model()),
             (LoadedProblem::Matrix(p), _) => matrix_states(p.cost_model()),
         };
-        crate::with_problem!(&self.problem, p => structure(p, &ids, states, Some(self.name.clone())))
+        Ok(crate::with_problem!(&self.problem, p => structure(p, &ids, states, Some(self.name.clone()))))
     }
 
     /// One id per task, in task order (see [`Instance::to_json`]).

@@ -172,6 +172,33 @@ pub struct Instance {
     /// The sequencing problem.
     pub problem: LoadedProblem,
     pub(crate) numbering: Numbering,
+    /// The one fixed edge of a TSP/ATSP file's `FIXED_EDGES_SECTION`, if it has one: the
+    /// problem is then the open path between its ends (see [`FixedEdge`]).
+    pub fixed_edge: Option<FixedEdge>,
+}
+
+/// A TSP or ATSP file's one fixed edge, read as TSPLIB's linhp318 reads it: the tour must use
+/// the edge from node `a` to node `b`, so what is solved is the Hamiltonian path from `b` to `a`
+/// through every node; the fixed edge closes it into the tour and is not counted in the cost
+/// (TSPLIB publishes linhp318's optimum that way). Answers list the path, from `b` to `a`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct FixedEdge {
+    /// The edge's first node as written (1-based); the path ends here.
+    pub a: u32,
+    /// The edge's second node (1-based); the path starts here.
+    pub b: u32,
+}
+
+impl FixedEdge {
+    /// The node the path starts from (`b`).
+    pub fn path_from(&self) -> u32 {
+        self.b
+    }
+
+    /// The node the path ends at (`a`).
+    pub fn path_to(&self) -> u32 {
+        self.a
+    }
 }
 
 impl Instance {

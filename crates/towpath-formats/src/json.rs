@@ -14,11 +14,12 @@ use towpath_seq::{End, MatrixCost, Metric, Mode, ModelError, PointCost, Problem,
 use crate::error::{ErrorKind, FormatError};
 use crate::instance::{Instance, Kind, LoadedProblem, Numbering};
 use crate::json_locate::{locate, path_text, Seg};
+use crate::json_shape::{friendly, MapOnly};
 use crate::tsplib::default_name;
 
 /// A problem in towpath's JSON format.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, remote = "Self")]
 pub struct JsonProblem {
     /// A name for reports (default: the file name).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -49,7 +50,7 @@ pub struct JsonProblem {
 
 /// The states: either points with a metric, or an explicit matrix.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, remote = "Self")]
 pub struct JsonStates {
     /// One point per state, 2 or 3 coordinates each.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -102,7 +103,7 @@ impl JsonMetric {
 
 /// A task: an id and its modes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, remote = "Self")]
 pub struct JsonTask {
     /// Unique id, used by precedence, groups, pins and answers.
     pub id: String,
@@ -112,7 +113,7 @@ pub struct JsonTask {
 
 /// A mode: entry state, exit state (default: the entry) and internal cost (default 0).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, remote = "Self")]
 pub struct JsonMode {
     /// State index where the task begins this way.
     pub entry: u32,
@@ -142,12 +143,30 @@ pub enum JsonEnd {
     At(u32),
 }
 
+/// The format's structs are read from JSON objects only (see [`MapOnly`]); written as usual.
+macro_rules! objects_only {
+    ($($t:ident),*) => {$(
+        impl<'de> Deserialize<'de> for $t {
+            fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                $t::deserialize(MapOnly(d))
+            }
+        }
+        impl Serialize for $t {
+            fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                $t::serialize(self, s)
+            }
+        }
+    )*};
+}
+
+objects_only!(JsonProblem, JsonStates, JsonTask, JsonMode);
+
 /// Parses JSON text into the serde model (no validation beyond types).
 pub fn parse_json_problem(text: &str, path: &Path) -> Result<JsonProblem, FormatError> {
     serde_json::from_str(text).map_err(|e| {
         let (line, column) = (e.line(), e.column());
         let msg = e.to_string();
-        let msg = msg.strip_suffix(&format!(" at line {line} column {column}")).unwrap_or(&msg).to_string();
+        let msg = friendly(msg.strip_suffix(&format!(" at line {line} column {column}")).unwrap_or(&msg));
         if line == 0 {
             FormatError::in_file(path, ErrorKind::Json(msg))
         } else {
@@ -252,7 +271,11 @@ impl JsonProblem {
                 let coord = |p: &[f64], k: usize| p.get(k).copied().unwrap_or(0.0);
                 let pts = points.iter().map(|p| [coord(p, 0), coord(p, 1), coord(p, 2)]).collect();
                 let metric = self.states.metric.unwrap_or(JsonMetric::Euclidean).metric();
-                LoadedProblem::Points(self.build(PointCost::new(pts, metric), &setup, &ctx)?)
+                let cost = PointCost::new(pts, metric);
+                let (line, _) = locate(text, &[Seg::Key("states"), Seg::Key("points")]).unwrap_or((1, 1));
+                let label = |s: u32| format!("states.points[{s}]");
+                crate::tsplib::check_exact(&cost, self.tasks.len() + 1, &label, line, path)?;
+                LoadedProblem::Points(self.build(cost, &setup, &ctx)?)
             }
             (None, Some(rows)) => {
                 let n = rows.len();
@@ -266,13 +289,20 @@ impl JsonProblem {
         };
         let name = self.name.clone().filter(|s| !s.is_empty()).unwrap_or_else(|| default_name(path));
         let ids = self.tasks.iter().map(|t| t.id.clone()).collect();
-        Ok(Instance { name, kind: Kind::Json, dimension: num_states, problem, numbering: Numbering::Tasks(ids) })
+        Ok(Instance {
+            name,
+            kind: Kind::Json,
+            dimension: num_states,
+            problem,
+            numbering: Numbering::Tasks(ids),
+            fixed_edge: None,
+        })
     }
 
     /// Checks the states and returns their number.
     fn check_states(&self, ctx: &Ctx<'_>) -> Result<usize, FormatError> {
         let st = &self.states;
-        let at = |rest: &[Seg]| [&[Seg::Key("states")][..], rest].concat();
+        let at = |rest: &[Seg<'static>]| [&[Seg::Key("states")][..], rest].concat();
         match (&st.points, &st.matrix) {
             (Some(_), Some(_)) => Err(ctx.invalid(&at(&[]), "give either `points` or `matrix`, not both".into())),
             (None, None) => Err(ctx.invalid(&at(&[]), "give `points` (with a `metric`) or `matrix`".into())),
@@ -377,6 +407,7 @@ impl JsonProblem {
                  `end` \"free\""
                     .into(),
             ),
+            e @ ModelError::CostTooLarge { .. } => ctx.invalid(&[Seg::Key("states")], e.to_string()),
             other => ctx.err(&[], ErrorKind::Model(other)),
         }
     }

@@ -1,20 +1,23 @@
 //! Finds the line and column of a value in JSON text by its path (`precedence[3][1]`), so that
-//! errors found after deserialization can point into the file like syntax errors do.
+//! errors found after deserialization can point into the file like syntax errors do. The one
+//! locator of the workspace: the JSON problem reader here and the travel-graph reader of
+//! `towpath-coverage` both use it.
 //!
-//! The text has already been parsed successfully by serde_json; this scanner only walks it and
-//! gives up (returns `None`) on anything unexpected, never panics.
+//! The text has usually been parsed successfully by serde_json already; this scanner only walks
+//! it (without recursion, so any nesting depth is fine) and gives up (returns `None`) on anything
+//! unexpected, never panics.
 
 /// One step of a JSON path.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub(crate) enum Seg {
-    /// An object member.
-    Key(&'static str),
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Seg<'a> {
+    /// An object member (its name as written, escapes and all).
+    Key(&'a str),
     /// An array element.
     Index(usize),
 }
 
 /// Renders a path as `tasks[2].modes[0].entry`.
-pub(crate) fn path_text(path: &[Seg]) -> String {
+pub fn path_text(path: &[Seg<'_>]) -> String {
     let mut s = String::new();
     for seg in path {
         match seg {
@@ -31,7 +34,7 @@ pub(crate) fn path_text(path: &[Seg]) -> String {
 }
 
 /// The 1-based line and column where the value at `path` begins.
-pub(crate) fn locate(text: &str, path: &[Seg]) -> Option<(usize, usize)> {
+pub fn locate(text: &str, path: &[Seg<'_>]) -> Option<(usize, usize)> {
     let b = text.as_bytes();
     let mut i = skip_ws(b, 0);
     for seg in path {
@@ -165,5 +168,22 @@ mod tests {
         assert_eq!(path_text(&p), "precedence[1][1]");
         assert_eq!(locate(t, &[Seg::Key("missing")]), None);
         assert_eq!(locate("{\"a\": [1", &[Seg::Key("a"), Seg::Index(3)]), None);
+    }
+
+    #[test]
+    fn finds_members_of_objects_in_arrays_and_gives_up_on_broken_text() {
+        let text =
+            "{\n  \"a\": [1, {\"x\": \"]\"}],\n  \"edges\": [\n    {\"a\": 0},\n    {\"a\": 7}\n  ],\n  \"s\": 3\n}";
+        assert_eq!(locate(text, &[Seg::Key("edges"), Seg::Index(1)]), Some((5, 5)));
+        assert_eq!(locate(text, &[Seg::Key("edges"), Seg::Index(1), Seg::Key("a")]), Some((5, 11)));
+        assert_eq!(locate(text, &[Seg::Key("s")]), Some((7, 8)));
+        assert_eq!(locate(text, &[Seg::Key("edges"), Seg::Index(2)]), None);
+        assert_eq!(locate(text, &[Seg::Key("nope")]), None);
+        assert_eq!(locate("[", &[Seg::Index(3)]), None);
+        assert_eq!(locate("\"abc", &[Seg::Key("x")]), None);
+        // Deeper than any recursion would go.
+        let deep = format!("{}{}", "[".repeat(100_000), "]".repeat(100_000));
+        assert_eq!(locate(&deep, &[Seg::Index(0), Seg::Index(0)]), Some((1, 3)));
+        assert_eq!(locate(&deep, &[Seg::Index(1)]), None);
     }
 }

@@ -25,7 +25,8 @@ mod error;
 mod export;
 mod instance;
 mod json;
-mod json_locate;
+pub mod json_locate;
+mod json_shape;
 mod matrix;
 mod sets;
 mod text;
@@ -35,8 +36,8 @@ mod tsplib;
 use std::path::Path;
 
 pub use error::{ErrorKind, FormatError};
-pub use export::CostsAs;
-pub use instance::{Answer, Instance, Kind, LoadedProblem, TaskStep, UnknownNode};
+pub use export::{CostsAs, ExportError, MAX_MATRIX_ENTRIES};
+pub use instance::{Answer, FixedEdge, Instance, Kind, LoadedProblem, TaskStep, UnknownNode};
 pub use json::{
     parse_json, parse_json_problem, write_json, JsonEnd, JsonMetric, JsonMode, JsonProblem, JsonStates, JsonTask,
 };

@@ -116,6 +116,8 @@ pub(crate) struct ReadMatrix {
     pub data: Vec<f64>,
     /// Entries equal to -1, as `(row, column, line)`.
     pub minus_ones: Vec<(usize, usize, usize)>,
+    /// The entry of largest magnitude, as `(value, row, column, line)` (the first of equals).
+    pub largest: Option<(f64, usize, usize, usize)>,
 }
 
 /// Reads an `EDGE_WEIGHT_SECTION` in the given layout.
@@ -159,7 +161,11 @@ pub(crate) fn read_matrix(
     };
     let mut data = vec![0.0; n * n];
     let mut minus_ones = Vec::new();
+    let mut largest: Option<(f64, usize, usize, usize)> = None;
     for ((i, j), &(v, line)) in format.positions(n).zip(values.iter().skip(skip)) {
+        if largest.is_none_or(|l| v.abs() > l.0.abs()) {
+            largest = Some((v, i, j, line));
+        }
         data[i * n + j] = v;
         if format.is_symmetric() {
             data[j * n + i] = v;
@@ -168,7 +174,7 @@ pub(crate) fn read_matrix(
             minus_ones.push((i, j, line));
         }
     }
-    Ok(ReadMatrix { data, minus_ones })
+    Ok(ReadMatrix { data, minus_ones, largest })
 }
 
 /// Parses a finite number.

@@ -13,11 +13,14 @@
 
 use std::path::Path;
 
-use towpath_seq::{End, MatrixCost, Metric, Mode, ModelError, PointCost, Problem, ProblemBuilder, StateId, TaskId};
+use towpath_seq::{
+    CostModel, End, MatrixCost, Metric, Mode, ModelError, PointCost, Problem, ProblemBuilder, StateId, TaskId,
+    EXACT_INTEGER_LIMIT,
+};
 
 use crate::coords::read_coords;
 use crate::error::{ErrorKind, FormatError};
-use crate::instance::{Instance, Kind, LoadedProblem, Numbering};
+use crate::instance::{FixedEdge, Instance, Kind, LoadedProblem, Numbering};
 use crate::matrix::parse_integer;
 use crate::matrix::{read_matrix, WeightFormat};
 use crate::sets::{read_ordering, read_sets, read_start};
@@ -54,19 +57,21 @@ pub fn parse_tsplib(text: &str, path: &Path) -> Result<Instance, FormatError> {
         .filter(|s| !s.is_empty())
         .unwrap_or_else(|| default_name(path));
     let costs = read_costs(&doc, kind, n, path)?;
+    let mut fixed_edge = None;
     let (problem, numbering) = match kind {
         Kind::Tsp | Kind::Atsp => {
             let fixed = match doc.section("FIXED_EDGES_SECTION") {
                 Some(s) => read_fixed_edge(s, n, path)?,
                 None => None,
             };
+            fixed_edge = fixed.map(|(a, b)| FixedEdge { a: a + 1, b: b + 1 });
             (build_tsp(costs, n, fixed, path)?, Numbering::Nodes((1..=n as u32).map(|v| vec![v]).collect()))
         }
         Kind::Sop => (build_sop(costs, n, path)?, Numbering::Nodes((1..=n as u32).map(|v| vec![v]).collect())),
         Kind::Gtsp | Kind::Pcgtsp => build_gtsp(&doc, kind, costs, n, path)?,
         Kind::Json => return Err(FormatError::in_file(path, ErrorKind::Unsupported("not a TSPLIB file".into()))),
     };
-    Ok(Instance { name, kind, dimension: n, problem, numbering })
+    Ok(Instance { name, kind, dimension: n, problem, numbering, fixed_edge })
 }
 
 /// A name without a known file extension (`ESC07.sop` → `ESC07`, `br17.10.sop` → `br17.10`).
@@ -138,21 +143,35 @@ fn check_sections(doc: &Document<'_>, kind: Kind, path: &Path) -> Result<(), For
     Ok(())
 }
 
-/// `DIMENSION`: the number of nodes, at least 1.
+/// The most nodes (and sets) a file may have: node and task numbers are 32-bit.
+pub(crate) const MAX_DIMENSION: u64 = u32::MAX as u64 - 1;
+
+/// `DIMENSION`: the number of nodes, from 1 to [`MAX_DIMENSION`].
 fn dimension(doc: &Document<'_>, path: &Path) -> Result<usize, FormatError> {
     let e = doc.entry("DIMENSION").ok_or_else(|| FormatError::in_file(path, ErrorKind::Missing("DIMENSION".into())))?;
-    match e.value.parse::<usize>() {
-        Ok(n) if n >= 1 && n < u32::MAX as usize => Ok(n),
+    count(e.value, "DIMENSION", e.line, path)
+}
+
+/// A count keyword's value: a positive integer up to [`MAX_DIMENSION`]; a larger one (even one
+/// beyond 64 bits) is refused as too large, not as "not an integer".
+pub(crate) fn count(value: &str, key: &str, line: usize, path: &Path) -> Result<usize, FormatError> {
+    let digits = value.strip_prefix('+').unwrap_or(value);
+    let all_digits = !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit());
+    match digits.parse::<u64>() {
+        Ok(n) if (1..=MAX_DIMENSION).contains(&n) => Ok(n as usize),
+        Ok(n) if n > MAX_DIMENSION => Err(too_large(key, value, line, path)),
+        Err(_) if all_digits && digits.trim_start_matches('0').len() > 3 => Err(too_large(key, value, line, path)),
         _ => Err(FormatError::at_line(
             path,
-            e.line,
-            ErrorKind::BadValue {
-                key: "DIMENSION".into(),
-                value: e.value.into(),
-                expected: "a positive integer".into(),
-            },
+            line,
+            ErrorKind::BadValue { key: key.into(), value: value.into(), expected: "a positive integer".into() },
         )),
     }
+}
+
+fn too_large(key: &str, value: &str, line: usize, path: &Path) -> FormatError {
+    let value = crate::matrix::short(value);
+    FormatError::at_line(path, line, ErrorKind::TooLarge { key: key.into(), value, max: MAX_DIMENSION })
 }
 
 fn read_costs(doc: &Document<'_>, kind: Kind, n: usize, path: &Path) -> Result<Costs, FormatError> {
@@ -178,6 +197,22 @@ fn read_costs(doc: &Document<'_>, kind: Kind, n: usize, path: &Path) -> Result<C
             .section("EDGE_WEIGHT_SECTION")
             .ok_or_else(|| FormatError::in_file(path, ErrorKind::Missing("EDGE_WEIGHT_SECTION".into())))?;
         let m = read_matrix(section, n, format, path)?;
+        if let Some((v, i, j, line)) = m.largest {
+            // TSPLIB matrices hold integers: a route of n moves must add up exactly.
+            let bound = v.abs() * n as f64;
+            if bound > EXACT_INTEGER_LIMIT {
+                return Err(FormatError::at_line(
+                    path,
+                    line,
+                    ErrorKind::InexactCosts {
+                        what: format!("the entry for node {} to node {} is {v}", i + 1, j + 1),
+                        moves: n,
+                        bound,
+                        scale: "matrix entries".into(),
+                    },
+                ));
+            }
+        }
         return Ok(Costs::Matrix { n, data: m.data, minus_ones: m.minus_ones });
     }
     let Some(&(_, dims, metric)) = COORD_TYPES.iter().find(|t| t.0 == ewt.value) else {
@@ -209,7 +244,49 @@ fn read_costs(doc: &Document<'_>, kind: Kind, n: usize, path: &Path) -> Result<C
         .section("NODE_COORD_SECTION")
         .ok_or_else(|| FormatError::in_file(path, ErrorKind::Missing("NODE_COORD_SECTION".into())))?;
     let points = read_coords(section, n, dims, path)?;
-    Ok(Costs::Points(PointCost::new(points, metric)))
+    let cost = PointCost::new(points, metric);
+    check_exact(&cost, n, &|node| format!("node {}", node + 1), section.line, path)?;
+    Ok(Costs::Points(cost))
+}
+
+/// A coordinate for a message: plain when short, else in exponent form (`4e19`).
+fn number(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// Refuses points so far apart that a route of `moves` integer distances (TSPLIB's roundings)
+/// could exceed 2⁵³ and no longer add up exactly, naming the two states farthest apart (by
+/// `label`) and pointing at `line`.
+pub(crate) fn check_exact(
+    cost: &PointCost,
+    moves: usize,
+    label: &dyn Fn(u32) -> String,
+    line: usize,
+    path: &Path,
+) -> Result<(), FormatError> {
+    let largest = cost.cost_bound().unwrap_or(0.0);
+    let bound = largest * moves as f64;
+    if !cost.is_integral() || bound <= EXACT_INTEGER_LIMIT {
+        return Ok(());
+    }
+    let (a, b) = cost.farthest_apart().unwrap_or((StateId(0), StateId(0)));
+    let (pa, pb) = (cost.points()[a.index()], cost.points()[b.index()]);
+    let axis = (0..3).max_by(|&x, &y| (pb[x] - pa[x]).abs().total_cmp(&(pb[y] - pa[y]).abs())).unwrap_or(0);
+    let what = format!(
+        "{} ({} = {}) and {} ({} = {}) are {} apart",
+        label(a.0),
+        ["x", "y", "z"][axis],
+        number(pa[axis]),
+        label(b.0),
+        ["x", "y", "z"][axis],
+        number(pb[axis]),
+        number((pb[axis] - pa[axis]).abs())
+    );
+    Err(FormatError::at_line(path, line, ErrorKind::InexactCosts { what, moves, bound, scale: "coordinates".into() }))
 }
 
 /// Replaces -1 entries by +∞ (forbidden moves) in SOP and PCGLNS matrices.
@@ -311,20 +388,7 @@ fn build_gtsp(
     path: &Path,
 ) -> Result<(LoadedProblem, Numbering), FormatError> {
     let declared = match doc.entry("GTSP_SETS") {
-        Some(e) => match e.value.parse::<usize>() {
-            Ok(m) => Some((m, e.line)),
-            Err(_) => {
-                return Err(FormatError::at_line(
-                    path,
-                    e.line,
-                    ErrorKind::BadValue {
-                        key: "GTSP_SETS".into(),
-                        value: e.value.into(),
-                        expected: "a positive integer".into(),
-                    },
-                ))
-            }
-        },
+        Some(e) => Some((count(e.value, "GTSP_SETS", e.line, path)?, e.line)),
         None => None,
     };
     let section = doc

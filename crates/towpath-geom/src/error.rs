@@ -5,13 +5,14 @@ use std::path::PathBuf;
 /// What can go wrong when reading or building a mesh. Every variant says what and where.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
-    /// The file could not be opened or read.
-    #[error("{path}: {source}")]
+    /// The file could not be opened or read. (The message includes the I/O error, so it is not
+    /// also given as the error's source: a reporter printing the chain would repeat it.)
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: PathBuf,
         /// The underlying error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file's content is not a valid mesh of its format.
     #[error("{format}: {message}")]
@@ -21,13 +22,13 @@ pub enum MeshError {
         /// What is wrong, with the line or element where known.
         message: String,
     },
-    /// The same, with the file name.
-    #[error("{path}: {source}")]
+    /// The same, with the file name (the inner error is part of the message, not a source).
+    #[error("{path}: {error}")]
     InFile {
         /// The file.
         path: PathBuf,
         /// The error inside it.
-        source: Box<MeshError>,
+        error: Box<MeshError>,
     },
     /// The file extension names no mesh format towpath reads.
     #[error("{path}: unknown mesh format (expected .stl, .obj or .ply)")]
@@ -67,7 +68,7 @@ impl MeshError {
     pub fn in_file(self, path: impl Into<PathBuf>) -> MeshError {
         match self {
             e @ (MeshError::Io { .. } | MeshError::InFile { .. } | MeshError::UnknownFormat { .. }) => e,
-            e => MeshError::InFile { path: path.into(), source: Box::new(e) },
+            e => MeshError::InFile { path: path.into(), error: Box::new(e) },
         }
     }
 }

@@ -8,8 +8,24 @@
 
 use std::sync::Arc;
 
-/// The cost of a transition. Integer-valued models (TSPLIB) are represented exactly.
+/// The cost of a transition. Integer-valued models (TSPLIB) are represented exactly while
+/// the sums stay below [`EXACT_INTEGER_LIMIT`].
 pub type Cost = f64;
+
+/// The largest cost a route may reach (a bound taken from [`CostModel::cost_bound`] when the
+/// problem is built). Far beyond any real job, it leaves room for what is computed from costs:
+/// squared coordinate differences of point models, and the solver's price of a forbidden move
+/// (a million times the largest cost) summed over a whole route, all stay finite.
+pub const MAX_ROUTE_COST: Cost = 1e150;
+
+/// 2⁵³: every integer up to it is exact in a [`Cost`]. Integer costs (TSPLIB's rounded
+/// distances and matrices) sum exactly while a route's total stays below it; readers of integer
+/// formats refuse instances whose routes could exceed it.
+pub const EXACT_INTEGER_LIMIT: Cost = 9_007_199_254_740_992.0;
+
+/// 2⁵²: from here on every `f64` is an integer, so rounding leaves it unchanged (and adding
+/// one half would round to even).
+const INTEGRAL_FROM: f64 = 4_503_599_627_370_496.0;
 
 /// Identifies one state of a [`CostModel`]: an index in `0..model.num_states()`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -45,6 +61,13 @@ pub trait CostModel: Send + Sync {
     fn position(&self, _state: StateId) -> Option<[f64; 3]> {
         None
     }
+
+    /// An upper bound on the magnitude of every finite cost, if the model knows one without
+    /// pricing every pair. [`crate::ProblemBuilder::build`] uses it to refuse problems whose
+    /// routes could cost more than [`MAX_ROUTE_COST`]. `None` (the default) means unknown.
+    fn cost_bound(&self) -> Option<Cost> {
+        None
+    }
 }
 
 impl<C: CostModel + ?Sized> CostModel for &C {
@@ -59,6 +82,9 @@ impl<C: CostModel + ?Sized> CostModel for &C {
     }
     fn position(&self, state: StateId) -> Option<[f64; 3]> {
         (**self).position(state)
+    }
+    fn cost_bound(&self) -> Option<Cost> {
+        (**self).cost_bound()
     }
 }
 
@@ -75,6 +101,9 @@ impl<C: CostModel + ?Sized> CostModel for Box<C> {
     fn position(&self, state: StateId) -> Option<[f64; 3]> {
         (**self).position(state)
     }
+    fn cost_bound(&self) -> Option<Cost> {
+        (**self).cost_bound()
+    }
 }
 
 impl<C: CostModel + ?Sized> CostModel for Arc<C> {
@@ -90,6 +119,9 @@ impl<C: CostModel + ?Sized> CostModel for Arc<C> {
     fn position(&self, state: StateId) -> Option<[f64; 3]> {
         (**self).position(state)
     }
+    fn cost_bound(&self) -> Option<Cost> {
+        (**self).cost_bound()
+    }
 }
 
 /// A dense, row-major cost matrix; asymmetric costs allowed.
@@ -98,6 +130,8 @@ pub struct MatrixCost {
     n: usize,
     data: Vec<Cost>,
     symmetric: bool,
+    /// The largest magnitude of a finite entry.
+    bound: Cost,
 }
 
 impl MatrixCost {
@@ -108,7 +142,8 @@ impl MatrixCost {
             return None;
         }
         let symmetric = (0..n).all(|i| (0..i).all(|j| data[i * n + j] == data[j * n + i]));
-        Some(MatrixCost { n, data, symmetric })
+        let bound = finite_bound(&data);
+        Some(MatrixCost { n, data, symmetric, bound })
     }
 
     /// Builds a matrix by evaluating `f(i, j)` for every pair.
@@ -121,7 +156,8 @@ impl MatrixCost {
         }
         // `from_fn` always produces n*n entries.
         let symmetric = (0..n).all(|i| (0..i).all(|j| data[i * n + j] == data[j * n + i]));
-        MatrixCost { n, data, symmetric }
+        let bound = finite_bound(&data);
+        MatrixCost { n, data, symmetric, bound }
     }
 
     /// The row-major entries.
@@ -146,6 +182,14 @@ impl CostModel for MatrixCost {
     fn is_symmetric(&self) -> bool {
         self.symmetric
     }
+    fn cost_bound(&self) -> Option<Cost> {
+        Some(self.bound)
+    }
+}
+
+/// The largest magnitude of the finite values (0 if none).
+fn finite_bound(data: &[Cost]) -> Cost {
+    data.iter().filter(|c| c.is_finite()).fold(0.0, |m: Cost, c| m.max(c.abs()))
 }
 
 /// How a distance between two points is turned into a cost.
@@ -176,6 +220,8 @@ pub struct PointCost {
     metric: Metric,
     /// Precomputed radians for [`Metric::Geo`].
     geo: Vec<[f64; 2]>,
+    /// A bound on every cost (see [`CostModel::cost_bound`]).
+    bound: Cost,
 }
 
 impl PointCost {
@@ -186,7 +232,40 @@ impl PointCost {
         } else {
             Vec::new()
         };
-        PointCost { points, metric, geo }
+        let bound = metric.bound(extents(&points));
+        PointCost { points, metric, geo, bound }
+    }
+
+    /// The two states whose coordinates differ most along one axis (the first such pair by
+    /// index), if there are two states: where a message about too large distances points.
+    pub fn farthest_apart(&self) -> Option<(StateId, StateId)> {
+        if self.points.len() < 2 {
+            return None;
+        }
+        let axes = if self.metric == Metric::Att { 2 } else { 3 };
+        let mut best: Option<(f64, usize, usize)> = None;
+        for k in 0..axes {
+            let (mut lo, mut hi) = (0, 0);
+            for (i, p) in self.points.iter().enumerate() {
+                if p[k] < self.points[lo][k] {
+                    lo = i;
+                }
+                if p[k] > self.points[hi][k] {
+                    hi = i;
+                }
+            }
+            let spread = self.points[hi][k] - self.points[lo][k];
+            if best.is_none_or(|b| spread > b.0) && lo != hi {
+                best = Some((spread, lo.min(hi), lo.max(hi)));
+            }
+        }
+        let (_, a, b) = best.unwrap_or((0.0, 0, 1));
+        Some((StateId(a as u32), StateId(b as u32)))
+    }
+
+    /// True when every cost is an integer (the TSPLIB roundings and GEO).
+    pub fn is_integral(&self) -> bool {
+        self.metric.is_integral()
     }
 
     /// The points.
@@ -200,10 +279,62 @@ impl PointCost {
     }
 }
 
+impl Metric {
+    /// True when the metric's costs are integers.
+    pub fn is_integral(self) -> bool {
+        !matches!(self, Metric::Euclidean | Metric::Manhattan)
+    }
+
+    /// A bound on the cost between any two points whose coordinates differ by at most
+    /// `extent` along each axis (infinite if an extent is).
+    fn bound(self, extent: [f64; 3]) -> Cost {
+        let [x, y, z] = extent;
+        match self {
+            Metric::Euclidean => norm(x, y, z),
+            Metric::EuclideanNint | Metric::EuclideanCeil => norm(x, y, z) + 1.0,
+            Metric::Att => norm(x, y, 0.0) / 10f64.sqrt() + 1.0,
+            Metric::Manhattan => x + y + z,
+            Metric::ManhattanNint => x + y + z + 1.0,
+            Metric::MaximumNint => x.max(y).max(z) + 1.0,
+            // half the earth's circumference (TSPLIB's radius, acos ≤ π) plus the rounding
+            Metric::Geo => 6378.388 * std::f64::consts::PI + 1.0,
+        }
+    }
+}
+
+/// The Euclidean norm of a vector without overflow in the squares.
+fn norm(x: f64, y: f64, z: f64) -> f64 {
+    let m = x.abs().max(y.abs()).max(z.abs());
+    if m == 0.0 || !m.is_finite() {
+        return m;
+    }
+    let (a, b, c) = (x / m, y / m, z / m);
+    m * (a * a + b * b + c * c).sqrt()
+}
+
+/// How far apart the points are along each axis (max − min; infinite if that overflows).
+fn extents(points: &[[f64; 3]]) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for (k, e) in out.iter_mut().enumerate() {
+        let lo = points.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+        let hi = points.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
+        if hi >= lo {
+            *e = hi - lo;
+        }
+        if points.iter().any(|p| p[k].is_nan()) {
+            *e = f64::INFINITY;
+        }
+    }
+    out
+}
+
 /// Smallest integer not below `x` (x ≥ 0), without a libm call. For TSPLIB's `ATT` this equals
-/// its "nint, plus one if below" rule.
+/// its "nint, plus one if below" rule. Exact for every `x`: from 2⁵² on `x` is an integer.
 #[inline]
 fn ceil_pos(x: f64) -> f64 {
+    if x >= INTEGRAL_FROM || x.is_nan() {
+        return x;
+    }
     let t = x as i64 as f64;
     if t < x {
         t + 1.0
@@ -241,9 +372,14 @@ fn geo_radians(x: f64) -> f64 {
 }
 
 /// TSPLIB's `nint`: round half up, as `(int)(x + 0.5)` in the reference code (x ≥ 0 here, so
-/// truncation is the floor; the cast avoids a libm call on baseline x86-64).
+/// truncation is the floor; the cast avoids a libm call on baseline x86-64). Exact for every
+/// `x`, where the reference code's `int` would overflow: from 2⁵² on `x` is an integer (and
+/// the cast would saturate at 2⁶³).
 #[inline]
 fn nint(x: f64) -> f64 {
+    if x >= INTEGRAL_FROM || x.is_nan() {
+        return x;
+    }
     (x + 0.5) as i64 as f64
 }
 
@@ -273,6 +409,10 @@ impl CostModel for PointCost {
         true
     }
 
+    fn cost_bound(&self) -> Option<Cost> {
+        Some(self.bound)
+    }
+
     fn position(&self, state: StateId) -> Option<[f64; 3]> {
         match self.metric {
             // GEO coordinates are angles: a k-d tree on them would mislead near the poles and
@@ -297,6 +437,71 @@ mod tests {
         // ATT: sqrt((100 + 0)/10) = 3.162 -> nint 3 < r -> 4
         let p = PointCost::new(vec![[0.0, 0.0, 0.0], [10.0, 0.0, 0.0]], Metric::Att);
         assert_eq!(p.cost(StateId(0), StateId(1)), 4.0);
+    }
+
+    proptest::proptest! {
+        /// The roundings agree with libm's `floor`/`ceil` (an independent computation) on
+        /// every magnitude, far beyond where the integer cast would saturate.
+        #[test]
+        fn roundings_exact_at_every_magnitude(mantissa in 1.0f64..10.0, exp in -3i32..300) {
+            let x = mantissa * 10f64.powi(exp);
+            // round half up: the floor, plus one if the fraction (exact in floating point) is ≥ ½
+            let half_up = x.floor() + if x - x.floor() >= 0.5 { 1.0 } else { 0.0 };
+            proptest::prop_assert_eq!(nint(x), half_up);
+            proptest::prop_assert_eq!(ceil_pos(x), x.ceil());
+        }
+    }
+
+    #[test]
+    fn large_coordinates_do_not_saturate() {
+        // Points on a line at 0, 1e19, 2e19, 3e19, 4e19 (issue 17): every rounded distance is
+        // the exact difference, not 2^63.
+        let xs = [0.0, 3e19, 1e19, 4e19, 2e19];
+        let pts: Vec<[f64; 3]> = xs.iter().map(|&x| [x, 0.0, 0.0]).collect();
+        for metric in [Metric::EuclideanNint, Metric::EuclideanCeil, Metric::ManhattanNint, Metric::MaximumNint] {
+            let p = PointCost::new(pts.clone(), metric);
+            for i in 0..5 {
+                for j in 0..5 {
+                    assert_eq!(p.cost(StateId(i), StateId(j)), (xs[i as usize] - xs[j as usize]).abs(), "{metric:?}");
+                }
+            }
+            assert!(p.cost_bound().unwrap() >= 4e19);
+            assert_eq!(p.farthest_apart(), Some((StateId(0), StateId(3))));
+        }
+    }
+
+    #[test]
+    fn bounds_cover_every_cost() {
+        // Pseudo-random points; the bound is at least every pairwise cost, for every metric.
+        let mut x = 12345u64;
+        let mut next = || {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((x >> 11) as f64 / (1u64 << 53) as f64 - 0.3) * 2000.0
+        };
+        let pts: Vec<[f64; 3]> = (0..40).map(|_| [next(), next(), next()]).collect();
+        let geo: Vec<[f64; 3]> = pts.iter().map(|p| [p[0] / 20.0, p[1] / 10.0, 0.0]).collect();
+        for metric in [
+            Metric::Euclidean,
+            Metric::EuclideanNint,
+            Metric::EuclideanCeil,
+            Metric::Att,
+            Metric::Manhattan,
+            Metric::ManhattanNint,
+            Metric::MaximumNint,
+            Metric::Geo,
+        ] {
+            let p = PointCost::new(if metric == Metric::Geo { geo.clone() } else { pts.clone() }, metric);
+            let bound = p.cost_bound().unwrap();
+            let max = (0..40u32)
+                .flat_map(|i| (0..40u32).map(move |j| (i, j)))
+                .map(|(i, j)| p.cost(StateId(i), StateId(j)))
+                .fold(0.0, f64::max);
+            assert!(max <= bound && bound <= 2.0 * max + 2.0, "{metric:?}: max {max}, bound {bound}");
+        }
+        let m = MatrixCost::new(2, vec![0.0, -7.0, f64::INFINITY, 3.0]).unwrap();
+        assert_eq!(m.cost_bound(), Some(7.0));
+        let far = vec![[0.0, 0.0, 0.0], [f64::MAX, 0.0, 0.0], [-f64::MAX, 0.0, 0.0]];
+        assert_eq!(PointCost::new(far, Metric::Euclidean).cost_bound(), Some(f64::INFINITY));
     }
 
     #[test]

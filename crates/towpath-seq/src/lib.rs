@@ -14,11 +14,19 @@
 //!   within a time or work budget. Deterministic under a work budget.
 //! - [`solve_exact`] is Held–Karp dynamic programming for small instances.
 //! - [`check`] independently verifies a route and recomputes its cost.
+//! - [`Clock`] is the one deadline and cancel flag of a run, shared by every solver and by the
+//!   instance builders that run before them.
+//!
+//! Costs are `f64`s. A problem whose route could cost more than [`MAX_ROUTE_COST`] is refused
+//! when it is built (for the models that know a bound on their costs, see
+//! [`CostModel::cost_bound`]), so sums never overflow; integer costs are exact while a route's
+//! total stays below [`EXACT_INTEGER_LIMIT`].
 //!
 //! This crate knows nothing of files, programs or HTTP.
 
 #![warn(missing_docs)]
 
+mod clock;
 mod cost;
 mod exact;
 mod model;
@@ -26,9 +34,10 @@ mod precedence;
 mod search;
 mod solution;
 
-pub use cost::{Cost, CostModel, MatrixCost, Metric, PointCost, StateId};
+pub use clock::Clock;
+pub use cost::{Cost, CostModel, MatrixCost, Metric, PointCost, StateId, EXACT_INTEGER_LIMIT, MAX_ROUTE_COST};
 pub use exact::{solve_exact, ExactError, MAX_EXACT_TASKS};
 pub use model::{End, Mode, ModelError, Problem, ProblemBuilder, TaskId};
 pub use precedence::Precedence;
-pub use search::{solve, Progress, ProgressFn, SolveError, SolveOptions, SolveReport};
+pub use search::{solve, Progress, ProgressFn, SolveError, SolveOptions, SolveReport, MAX_THREADS};
 pub use solution::{check, Solution, Step, Violation};

@@ -7,7 +7,7 @@
 //! anything else in between. The route may start from a fixed state, end at a fixed state, return
 //! to its start (a closed tour) or end anywhere (an open path).
 
-use crate::cost::{Cost, CostModel, StateId};
+use crate::cost::{Cost, CostModel, StateId, MAX_ROUTE_COST};
 use crate::precedence::Precedence;
 
 /// Identifies a task: an index in `0..problem.num_tasks()`.
@@ -112,6 +112,20 @@ pub enum ModelError {
     /// A closed tour with no start state needs a pinned first task to give precedence a meaning.
     #[error("a closed tour without a start state has no beginning: pin a first task to use precedence")]
     PrecedenceNeedsAnchor,
+    /// A route could cost more than [`MAX_ROUTE_COST`]: its costs are too large for towpath to
+    /// add up.
+    #[error(
+        "costs are too large: a route of {transitions} moves of up to {largest:e} each could cost {bound:e}, \
+         more than the {MAX_ROUTE_COST:e} towpath adds up; scale the costs or coordinates down"
+    )]
+    CostTooLarge {
+        /// The bound on a single transition cost.
+        largest: Cost,
+        /// Transitions a route has at most.
+        transitions: usize,
+        /// The bound on a route's cost (transitions and mode costs).
+        bound: Cost,
+    },
 }
 
 /// A sequencing problem over a cost model `C`.
@@ -368,6 +382,19 @@ impl<C: CostModel> ProblemBuilder<C> {
         if let Some(s) = self.start {
             check_state(s)?;
         }
+        if let Some(largest) = self.cost.cost_bound() {
+            // One move into each task and one to end the route, plus every task's dearest mode.
+            let transitions = n + 1;
+            let modes_cost: Cost = self
+                .tasks
+                .iter()
+                .map(|ms| ms.iter().filter(|m| m.cost.is_finite()).fold(0.0, |a: Cost, m| a.max(m.cost.abs())))
+                .sum();
+            let bound = largest * transitions as Cost + modes_cost;
+            if bound.is_nan() || bound > MAX_ROUTE_COST {
+                return Err(ModelError::CostTooLarge { largest, transitions, bound });
+            }
+        }
         if let End::At(s) = self.end {
             check_state(s)?;
         }
@@ -453,5 +480,35 @@ fn check_groups_against_precedence(
         Err(cycle) => Err(ModelError::GroupPrecedenceConflict(
             cycle.into_iter().filter(|&x| (x as usize) < num_groups).map(|x| x as usize).collect(),
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cost::{MatrixCost, Metric, PointCost};
+
+    #[test]
+    fn costs_too_large_to_add_up_are_refused() {
+        // Five points 4e19 apart at most: fine (a route costs at most 6 · 4e19).
+        let pts: Vec<[f64; 3]> = [0.0, 3e19, 1e19, 4e19, 2e19].iter().map(|&x| [x, 0.0, 0.0]).collect();
+        let mut b = Problem::builder(PointCost::new(pts, Metric::EuclideanNint));
+        b.point_tasks(5);
+        assert!(b.build().is_ok());
+        // 5e149 apart: 3 moves exceed MAX_ROUTE_COST.
+        let mut b = Problem::builder(PointCost::new(vec![[0.0; 3], [5e149, 0.0, 0.0]], Metric::Euclidean));
+        b.point_tasks(2);
+        let e = b.build().unwrap_err();
+        assert!(matches!(e, ModelError::CostTooLarge { transitions: 3, .. }), "{e}");
+        // A matrix entry of 1e300 (forbidden entries do not count), or a mode cost.
+        let mut b = Problem::builder(MatrixCost::new(2, vec![0.0, 1e300, f64::INFINITY, 0.0]).unwrap());
+        b.point_tasks(2);
+        assert!(matches!(b.build(), Err(ModelError::CostTooLarge { .. })));
+        let mut b = Problem::builder(MatrixCost::new(2, vec![0.0, 1.0, f64::INFINITY, 0.0]).unwrap());
+        b.point_tasks(2);
+        assert!(b.build().is_ok());
+        let mut b = Problem::builder(MatrixCost::new(1, vec![0.0]).unwrap());
+        b.task(vec![Mode { entry: StateId(0), exit: StateId(0), cost: 1e200 }]);
+        assert!(matches!(b.build(), Err(ModelError::CostTooLarge { .. })));
     }
 }

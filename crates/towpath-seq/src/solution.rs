@@ -88,6 +88,9 @@ pub enum Violation {
     /// A transition or mode on the route has a non-finite cost (a forbidden move).
     #[error("the route uses a forbidden (non-finite cost) transition at step {0}")]
     Forbidden(usize),
+    /// Every move of the route has a finite cost but their sum does not fit in a [`Cost`].
+    #[error("the route's cost overflows: its moves are finite but their sum is not")]
+    CostOverflow,
 }
 
 /// Checks that `steps` is a feasible route of `problem` and returns its cost, recomputed from
@@ -164,6 +167,9 @@ pub fn check<C: CostModel>(problem: &Problem<C>, steps: &[Step]) -> Result<Cost,
         }
         total += back;
     }
+    if !total.is_finite() {
+        return Err(Violation::CostOverflow);
+    }
     Ok(total)
 }
 
@@ -201,4 +207,37 @@ fn check_groups<C: CostModel>(problem: &Problem<C>, steps: &[Step]) -> Result<()
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cost::StateId;
+    use crate::model::Mode;
+
+    /// Every move costs 1e308, and the model gives no bound: the route's sum overflows.
+    struct Huge;
+    impl CostModel for Huge {
+        fn num_states(&self) -> usize {
+            3
+        }
+        fn cost(&self, from: StateId, to: StateId) -> Cost {
+            if from == to {
+                0.0
+            } else {
+                1e308
+            }
+        }
+    }
+
+    #[test]
+    fn an_overflowing_sum_is_not_a_cost() {
+        let mut b = Problem::builder(Huge);
+        for s in 0..3 {
+            b.task(vec![Mode::point(StateId(s))]);
+        }
+        let p = b.build().unwrap();
+        let steps: Vec<Step> = (0..3).map(|t| Step { task: TaskId(t), mode: 0 }).collect();
+        assert_eq!(check(&p, &steps), Err(Violation::CostOverflow));
+    }
 }

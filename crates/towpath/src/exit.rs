@@ -88,6 +88,9 @@ fn code_of_type(cause: &(dyn std::error::Error + 'static)) -> Option<i32> {
             || c.is::<towpath_machine::CostError>()
             || c.is::<towpath_coverage::InstanceError>()
             || c.is::<towpath_coverage::ReadError>()
+            || c.is::<towpath_coverage::BuildError>()
+            || c.is::<towpath_coverage::GenerateError>()
+            || c.is::<towpath_formats::ExportError>()
             || c.is::<towpath_seq::ModelError>()
             || c.is::<towpath_seq::SolveError>()
             || c.is::<towpath_baselines::BaselineError>() =>

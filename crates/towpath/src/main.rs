@@ -34,8 +34,6 @@ enum Command {
     Verify(cmd::verify::Args),
     /// Integrate separate tool paths into one open route over a travel graph (Tewolde & Sheng's (2008) open rural postman).
     Route(cmd::route::Args),
-    /// Run a benchmark and print (or write into BENCHMARKS.md) its tables.
-    Bench(cmd::bench::Args),
     /// Order cut contours and plotter strokes (SVG, DXF, G-code, JSON): least rapid travel, holes first.
     Order(Box<cmd::order::Args>),
     /// Plan 2.5D pocket machining: toolpath cells per tool linked with the least airtime (Castelino et al. 2003).
@@ -54,7 +52,6 @@ fn main() {
         Command::Optimize(args) => cmd::optimize::run(args),
         Command::Verify(args) => cmd::verify::run(args),
         Command::Route(args) => cmd::route::run(args),
-        Command::Bench(args) => cmd::bench::run(args),
         Command::Order(args) => cmd::order::run(*args),
         Command::Machine(args) => cmd::machine::run(args),
         Command::Serve(args) => cmd::serve::run(args),

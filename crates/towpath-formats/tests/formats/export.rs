@@ -30,7 +30,7 @@ const FIXTURES: &[&str] = &[
 
 /// Converts and reads back through the JSON text.
 fn round_trip(inst: &Instance, costs: CostsAs) -> Instance {
-    let text = write_json(&inst.to_json(costs));
+    let text = write_json(&inst.to_json(costs).unwrap());
     parse_json(&text, Path::new("converted.json")).unwrap_or_else(|e| panic!("{}: {e}\n{text}", inst.name))
 }
 
@@ -134,14 +134,14 @@ fn json_route(
 
 #[test]
 fn task_ids_name_nodes_and_sets() {
-    let tsp = load("burma14.tsp").to_json(CostsAs::Native);
+    let tsp = load("burma14.tsp").to_json(CostsAs::Native).unwrap();
     assert_eq!(tsp.tasks.first().map(|t| t.id.as_str()), Some("1"));
     assert_eq!(tsp.tasks.last().map(|t| t.id.as_str()), Some("14"));
     assert!(tsp.states.points.is_some() && tsp.states.matrix.is_none());
-    let gtsp = load("3burma14.gtsp").to_json(CostsAs::Matrix);
+    let gtsp = load("3burma14.gtsp").to_json(CostsAs::Matrix).unwrap();
     assert_eq!(gtsp.tasks.iter().map(|t| t.id.as_str()).collect::<Vec<_>>(), ["set1", "set2", "set3"]);
     assert_eq!(gtsp.tasks.iter().map(|t| t.modes.len()).sum::<usize>(), 14, "every node is a mode of its set");
-    let sop = load("ESC07.sop").to_json(CostsAs::Native);
+    let sop = load("ESC07.sop").to_json(CostsAs::Native).unwrap();
     let rows = sop.states.matrix.as_ref().unwrap();
     // ESC07's row 2 starts with -1: node 1 precedes node 2 and the move 2 -> 1 is forbidden.
     assert_eq!(rows[1][0], None);

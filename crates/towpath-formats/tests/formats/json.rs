@@ -61,7 +61,7 @@ fn matrix_states_with_forbidden_moves() {
 
 #[test]
 fn syntax_and_type_errors_carry_serde_positions() {
-    expect(&BASE.replace(r#""entry": 0 }"#, r#""entry": "zero" }"#), 4, 45, "invalid type: string");
+    expect(&BASE.replace(r#""entry": 0 }"#, r#""entry": "zero" }"#), 4, 45, "found string");
     expect(&BASE.replace(r#""end": "free""#, r#""end": "open""#), 8, 15, "unknown variant `open`");
     expect(&BASE.replace(r#""precedence""#, r#""precedense""#), 7, 14, "unknown field `precedense`");
     let e = refuse("{\n  \"states\": ");

@@ -225,6 +225,10 @@ fn a_fixed_edge_makes_an_open_path_between_its_ends() {
     assert!(cost >= opt && cost <= 1.10 * opt && cost < opt + edge, "{cost} vs optimum {opt}");
     let tour = nodes(&inst.answer(&report.solution.steps));
     assert_eq!((tour.first(), tour.last()), (Some(&214), Some(&1)));
+    // The instance says so, for the summary and the JSON.
+    let f = inst.fixed_edge.unwrap();
+    assert_eq!((f.a, f.b, f.path_from(), f.path_to()), (1, 214, 214, 1));
+    assert!(load("att48.tsp").fixed_edge.is_none());
 }
 
 #[test]

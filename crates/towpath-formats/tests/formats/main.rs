@@ -5,4 +5,5 @@ mod errors;
 mod export;
 mod json;
 mod known;
+mod limits;
 mod props;

@@ -51,7 +51,7 @@ pub fn read_bytes(bytes: &[u8], format: Format) -> Result<Soup, MeshError> {
 /// Reads a mesh file, the format chosen by extension. Errors name the file.
 pub fn read_path(path: &Path) -> Result<Soup, MeshError> {
     let format = Format::from_path(path).ok_or_else(|| MeshError::UnknownFormat { path: path.to_path_buf() })?;
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_path_buf(), source })?;
+    let bytes = std::fs::read(path).map_err(|error| MeshError::Io { path: path.to_path_buf(), error })?;
     read_bytes(&bytes, format).map_err(|e| e.in_file(path))
 }
 
@@ -69,8 +69,8 @@ pub fn write_bytes(soup: &Soup, format: Format) -> std::io::Result<Vec<u8>> {
 /// Writes a mesh file, the format chosen by extension (STL is written binary, PLY ascii).
 pub fn write_path(path: &Path, soup: &Soup) -> Result<(), MeshError> {
     let format = Format::from_path(path).ok_or_else(|| MeshError::UnknownFormat { path: path.to_path_buf() })?;
-    let out = write_bytes(soup, format).map_err(|source| MeshError::Io { path: path.to_path_buf(), source })?;
-    std::fs::write(path, out).map_err(|source| MeshError::Io { path: path.to_path_buf(), source })
+    let out = write_bytes(soup, format).map_err(|error| MeshError::Io { path: path.to_path_buf(), error })?;
+    std::fs::write(path, out).map_err(|error| MeshError::Io { path: path.to_path_buf(), error })
 }
 
 /// Fans a polygon (vertex indices) into triangles.

@@ -36,6 +36,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use crate::clock::Clock;
 use crate::cost::{Cost, CostModel};
 use crate::exact::solve_exact;
 use crate::model::{Problem, TaskId};
@@ -139,12 +140,25 @@ pub enum SolveError {
     /// No feasible route was found (every route uses a forbidden transition).
     #[error("no feasible route found: {0}")]
     NoFeasibleRoute(Violation),
+    /// More worker threads were asked for than the solver runs.
+    #[error("{threads} threads asked for; the solver runs at most {MAX_THREADS}")]
+    TooManyThreads {
+        /// The number asked for.
+        threads: usize,
+    },
 }
+
+/// The most worker threads [`solve`] runs (each keeps its own copy of the tour).
+pub const MAX_THREADS: usize = 1024;
 
 /// Solves a problem with towpath's best solver.
 pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<SolveReport, SolveError> {
-    let t0 = Instant::now();
-    let deadline = opts.time_limit.map(|d| t0 + d);
+    if opts.threads > MAX_THREADS {
+        return Err(SolveError::TooManyThreads { threads: opts.threads });
+    }
+    let clock = Clock::for_options(opts);
+    let t0 = clock.started();
+    let deadline = clock.deadline();
     let initial_cost = match &opts.initial {
         Some(steps) => Some(check(problem, steps).map_err(SolveError::BadInitial)?),
         None => None,
@@ -263,7 +277,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         if search_end.is_some_and(|d| Instant::now() >= d) {
             break;
         }
-        if opts.cancel.as_ref().is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+        if clock.cancelled() {
             break;
         }
         let epoch_deadline = match (search_end, slice) {
@@ -275,7 +289,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         let frac = budget_used(opts, t0, iterations).unwrap_or(1.0);
         let temperature = acceptance_temperature(&net, best.cost, frac);
         let budget = Budget { kicks: kicks_each, deadline: epoch_deadline, hard: search_end, temperature };
-        let cancel = opts.cancel.as_deref();
+        let cancel = clock.cancel_flag().map(|c| &**c);
         let done: u64 = if threads == 1 {
             ils.run(&mut chains[0], budget, cancel)
         } else {
@@ -322,7 +336,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
             break;
         }
     }
-    if !opts.cancel.as_ref().is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+    if !clock.cancelled() {
         ils.descend(&mut best, deadline);
     }
     optimize_final(&net, &mut best, eps);

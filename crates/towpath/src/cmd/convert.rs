@@ -53,7 +53,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let instance = read_instance(&args.file).map_err(exit::bad_input)?;
     let costs = if args.matrix { CostsAs::Matrix } else { CostsAs::Native };
     let text = match args.to {
-        Target::Json => write_json(&instance.to_json(costs)),
+        Target::Json => write_json(
+            &instance
+                .to_json(costs)
+                .map_err(|e| exit::bad_input(anyhow::anyhow!("{}: --matrix: {e}", args.file.display())))?,
+        ),
     };
     match &args.output {
         Some(out) => {

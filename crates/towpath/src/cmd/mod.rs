@@ -1,8 +1,6 @@
 //! One module per subcommand.
 
 mod afp_common;
-pub mod bench;
-pub mod bench_baselines;
 pub mod convert;
 pub mod demo;
 pub mod layup;

@@ -1,4 +1,4 @@
-//! `towpath route`: the open rural postman job of seed 004. Reads a travel graph with required
+//! `towpath route`: the open rural postman job of Tewolde & Sheng (2008). Reads a travel graph with required
 //! edges (JSON), orders and orients the required edges so that the connecting travel along
 //! shortest paths is least, and writes the full vertex walk.
 
@@ -6,10 +6,12 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use anyhow::Context;
+use anyhow::{anyhow, Context};
 use towpath_baselines::{solve_with, SolverName};
-use towpath_coverage::{read_instance, seed004_like, verify_route, write_instance, Instance, RouteJson, RppModel};
-use towpath_seq::SolveOptions;
+use towpath_coverage::{
+    read_instance, seed004_like, verify_route, write_instance, BuildError, Instance, RouteJson, RppModel,
+};
+use towpath_seq::{Clock, SolveOptions};
 
 use crate::cmd::solver_args::{refused, SolverArgs};
 use crate::files::Files;
@@ -17,8 +19,8 @@ use crate::{exit, outln};
 
 /// Arguments of `towpath route`.
 #[derive(clap::Args, Debug)]
-#[command(after_long_help = "Integrates separate tool paths into one open route (seed 004's open rural postman \
-problem). The input is a travel graph in JSON: vertices with coordinates, undirected edges with lengths, \
+#[command(after_long_help = "Integrates separate tool paths into one open route (the open rural postman \
+problem of Tewolde & Sheng 2008). The input is a travel graph in JSON: vertices with coordinates, undirected edges with lengths, \
 some edges marked \"required\" (each a tool path to be done once, in either direction). The tool travels \
 between required edges along shortest paths. The output is the full vertex walk, including connecting paths.
 
@@ -30,7 +32,7 @@ pub struct Args {
     /// The travel graph (JSON). Omit with --generate.
     #[arg(value_name = "GRAPH.json", required_unless_present = "generate")]
     pub graph: Option<PathBuf>,
-    /// Instead of reading a file, generate an instance shaped like seed 004's sample data with
+    /// Instead of reading a file, generate an instance shaped like Tewolde & Sheng's (2008) sample data with
     /// this many required edges (and twice as many vertices).
     #[arg(long, value_name = "R", conflicts_with = "graph")]
     pub generate: Option<usize>,
@@ -40,14 +42,15 @@ pub struct Args {
     /// Write the instance (read or generated) to this JSON file.
     #[arg(long, value_name = "FILE")]
     pub save_instance: Option<PathBuf>,
-    /// Time limit for the solver, in seconds (the seed papers' solvers run their own budgets and
-    /// stop early only if this passes).
+    /// Time limit of the whole command, in seconds: reading or generating the graph, its shortest
+    /// paths and the solver (the seed papers' solvers run their own budgets and stop early only if
+    /// this passes). Shortest paths that cannot be done in time are refused with what they need.
     #[arg(long, default_value_t = 10.0)]
     pub time_limit: f64,
     /// Seed for the solver's random choices (same seed, same answer under a work budget).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Solver threads (default: all cores).
+    /// Threads of the shortest paths and the solver (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
     /// Write the route (JSON) to this file.
@@ -62,6 +65,8 @@ pub struct Args {
 
 /// Runs `towpath route`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    let clock = Clock::start(Some(super::solver_args::time_limit(args.time_limit)?), None);
+    let threads = super::solver_args::threads(args.threads)?;
     let mut files = Files::new();
     if let Some(g) = &args.graph {
         files.input("graph", g)?;
@@ -76,15 +81,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(path) = &args.save_instance {
         files.write(path, write_instance(&instance))?;
     }
-    let model = RppModel::new(instance).map_err(exit::bad_input)?;
-    let mut opts = SolveOptions {
-        time_limit: Some(super::solver_args::time_limit(args.time_limit)?),
-        seed: args.seed,
-        ..SolveOptions::default()
-    };
-    if let Some(t) = args.threads {
-        opts.threads = t.max(1);
-    }
+    let model = RppModel::build(instance, &clock, threads).map_err(|e| {
+        let hint = match &e {
+            BuildError::OutOfTime(stop) if !stop.cancelled => {
+                format!("; give --time-limit {:.0} or more", (stop.estimate * 1.5 + 1.0).ceil())
+            }
+            _ => String::new(),
+        };
+        exit::bad_input(anyhow!("{}: {e}{hint}", source(&args)))
+    })?;
+    // The solver has what is left of the time limit.
+    let mut opts = SolveOptions { time_limit: clock.remaining(), seed: args.seed, threads, ..SolveOptions::default() };
     let name = args.solver.solver;
     // A progress bar on stderr for the time-limited searches, only on a terminal.
     let bar =
@@ -132,6 +139,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         outln!("  connecting travel  : {:>12.3}", out.deadhead_length);
         outln!("  vertices on walk   : {:>12}", route.vertices.len());
         outln!("  solver time        : {:>12.3} s", report.elapsed.as_secs_f64());
+        outln!("  total time         : {:>12.3} s", clock.elapsed().as_secs_f64());
+        outln!(
+            "  verified           : yes (independent check: the walk follows the graph's edges, serves every \
+             required edge once and is {length:.3} long)"
+        );
         if let Some(path) = &args.output {
             outln!("  route written to   : {}", path.display());
         }
@@ -139,18 +151,24 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Names the graph in messages: its file, or the generated instance.
+fn source(args: &Args) -> String {
+    match (&args.graph, args.generate) {
+        (Some(path), _) => path.display().to_string(),
+        (None, Some(r)) => format!("--generate {r}"),
+        (None, None) => "the graph".into(),
+    }
+}
+
 fn load(args: &Args) -> anyhow::Result<Instance> {
     if let Some(r) = args.generate {
-        if r == 0 {
-            return Err(exit::bad_input(anyhow::anyhow!("--generate needs at least 1 required edge")));
-        }
-        return Ok(seed004_like(r, args.generate_seed));
+        return seed004_like(r, args.generate_seed).map_err(|e| exit::bad_input(anyhow!("--generate {r}: {e}")));
     }
     let Some(path) = &args.graph else {
-        return Err(exit::bad_input(anyhow::anyhow!("give a GRAPH.json file or --generate R")));
+        return Err(exit::bad_input(anyhow!("give a GRAPH.json file or --generate R")));
     };
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("reading {}", path.display()))
         .map_err(exit::bad_input)?;
-    read_instance(&text).map_err(|e| exit::bad_input(anyhow::anyhow!("{}: {e}", path.display())))
+    read_instance(&text).map_err(|e| exit::bad_input(anyhow!("{}: {e}", path.display())))
 }

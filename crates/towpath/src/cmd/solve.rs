@@ -2,14 +2,14 @@
 //! JSON), solves it, checks the answer independently and prints it in the file's numbering.
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::anyhow;
 use towpath_baselines::{solve_with, SolverName};
-use towpath_formats::{read_instance, with_problem, Instance};
-use towpath_seq::{Progress, SolveOptions, SolveReport};
+use towpath_formats::{read_instance, with_problem, Instance, Kind};
+use towpath_seq::{End, Progress, SolveOptions, SolveReport};
 
 use crate::cmd::solver_args::{refusal, SolverArgs};
 use crate::{exit, outln};
@@ -59,8 +59,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (None, Some(_)) => None,
         (None, None) => Some(Duration::from_secs_f64(DEFAULT_TIME_LIMIT)),
     };
-    let threads = args.threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1);
-    let instance = read_instance(&args.file).map_err(exit::bad_input)?;
+    let threads = super::solver_args::threads(args.threads)?;
+    let instance = read_instance(&args.file).map_err(|e| match other_command(&args.file) {
+        Some(hint) => exit::bad_input(anyhow!("{}: {hint}", args.file.display())),
+        None => exit::bad_input(e),
+    })?;
 
     // Only towpath's search (alone or inside castelino) reports progress.
     let reports_progress = matches!(args.solver.solver, SolverName::Towpath | SolverName::Castelino);
@@ -93,6 +96,46 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// For a file `solve` cannot read: the command it is meant for, if it is recognisably one of
+/// the other commands' inputs (an AFP program, a travel graph, a mesh).
+fn other_command(path: &Path) -> Option<String> {
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    let bytes = std::fs::read(path).ok()?;
+    let text = String::from_utf8_lossy(&bytes[..bytes.len().min(64 * 1024)]);
+    let program = |text: &str| {
+        let mut codes = 0;
+        for line in text.lines().map(str::trim).filter(|l| !l.is_empty()).take(50) {
+            let word = line.trim_start_matches(|c: char| c == 'N' || c.is_ascii_digit()).trim_start();
+            let first = word.chars().next().unwrap_or(' ').to_ascii_uppercase();
+            if matches!(first, 'G' | 'M') && word[1..].starts_with(|c: char| c.is_ascii_digit()) {
+                codes += 1;
+            }
+        }
+        codes >= 2
+    };
+    if matches!(ext.as_str(), "nc" | "ngc" | "gcode" | "tap" | "cnc") || program(&text) {
+        return Some(format!(
+            "this is an AFP program (G-code), not a sequencing problem: re-sequence it with `towpath optimize {} \
+             --machine MACHINE.toml`",
+            path.display()
+        ));
+    }
+    if text.contains("\"vertices\"") && text.contains("\"edges\"") {
+        return Some(format!(
+            "this is a travel graph with required edges (towpath-rpp/1), not a sequencing problem: route it with \
+             `towpath route {}`",
+            path.display()
+        ));
+    }
+    if matches!(ext.as_str(), "stl" | "obj" | "ply") {
+        return Some(format!(
+            "this is a mesh, not a sequencing problem: lay fiber courses on it with `towpath layup {} …`",
+            path.display()
+        ));
+    }
+    None
+}
+
 /// A progress bar on stderr, only when stderr is a terminal.
 fn progress_bar(bounded: bool) -> Option<indicatif::ProgressBar> {
     if !bounded || !std::io::stderr().is_terminal() {
@@ -107,25 +150,37 @@ fn progress_bar(bounded: bool) -> Option<indicatif::ProgressBar> {
 
 fn print_answer(args: &Args, instance: &Instance, report: &SolveReport, cost: f64, threads: usize) {
     let tour = instance.answer(&report.solution.steps);
+    let closed = with_problem!(&instance.problem, p => p.end() == End::Closed);
     if args.json {
-        outln!(
-            "{}",
-            serde_json::json!({
-                "file": args.file.display().to_string(),
-                "name": instance.name,
-                "type": instance.kind.as_str(),
-                "solver": args.solver.solver.as_str(),
-                "dimension": instance.dimension,
-                "tasks": instance.num_tasks(),
-                "cost": cost,
-                "tour": tour,
-                "time_seconds": report.elapsed.as_secs_f64(),
-                "iterations": report.iterations,
-                "exact": report.exact,
-                "seed": args.seed,
-                "threads": threads,
-            })
-        );
+        let mut json = serde_json::json!({
+            "file": args.file.display().to_string(),
+            "name": instance.name,
+            "type": instance.kind.as_str(),
+            "solver": args.solver.solver.as_str(),
+            "dimension": instance.dimension,
+            "tasks": instance.num_tasks(),
+            "cost": cost,
+            "route": if closed { "tour" } else { "path" },
+            "tour": tour,
+            "time_seconds": report.elapsed.as_secs_f64(),
+            "iterations": report.iterations,
+            "exact": report.exact,
+            "seed": args.seed,
+            "threads": threads,
+        });
+        if let (Some(f), Some(obj)) = (instance.fixed_edge, json.as_object_mut()) {
+            obj.insert(
+                "fixed_edge".into(),
+                serde_json::json!({
+                    "a": f.a,
+                    "b": f.b,
+                    "path_from": f.path_from(),
+                    "path_to": f.path_to(),
+                    "counted": false,
+                }),
+            );
+        }
+        outln!("{json}");
         return;
     }
     outln!(
@@ -142,6 +197,17 @@ fn print_answer(args: &Args, instance: &Instance, report: &SolveReport, cost: f6
         args.seed,
         threads
     );
+    if let Some(f) = instance.fixed_edge {
+        let (link, arc) = if instance.kind == Kind::Atsp { ("→", "arc") } else { ("–", "edge") };
+        outln!(
+            "route: a path from node {} to node {}, as TSPLIB's linhp318: the fixed {arc} {} {link} {} \
+             (FIXED_EDGES_SECTION) closes it into the tour and is not counted in the cost",
+            f.path_from(),
+            f.path_to(),
+            f.a,
+            f.b
+        );
+    }
     const SHOWN: usize = 40;
     let text = tour.to_string();
     if tour.len() <= SHOWN {

@@ -52,8 +52,32 @@ impl SolverArgs {
 pub fn refusal(name: SolverName, e: &BaselineError) -> String {
     let text = e.to_string();
     let text = if text.starts_with(name.as_str()) { text } else { format!("solver {name}: {text}") };
+    if let BaselineError::TooMuch { param, .. } = e {
+        let flag = match *param {
+            "ga.population" => "--ga-population",
+            "ga.generations" => "--ga-generations",
+            "aco.cycles" => "--aco-cycles",
+            _ => return text,
+        };
+        return format!("{text} ({flag})");
+    }
+    if let BaselineError::Solve(towpath_seq::SolveError::TooManyThreads { .. }) = e {
+        return format!("{text} (--threads)");
+    }
     let hint = if name == SolverName::Towpath { "" } else { " (--solver towpath takes every valid problem)" };
     format!("{text}{hint}")
+}
+
+/// A `--threads` value: at least 1, at most what the solver runs (refused with exit code 2).
+/// `None` gives the machine's available cores.
+pub fn threads(threads: Option<usize>) -> anyhow::Result<usize> {
+    let max = towpath_seq::MAX_THREADS;
+    match threads {
+        None => Ok(std::thread::available_parallelism().map_or(1, |n| n.get()).min(max)),
+        Some(0) => Err(exit::bad_input(anyhow::anyhow!("--threads 0: give at least 1"))),
+        Some(t) if t > max => Err(exit::bad_input(anyhow::anyhow!("--threads {t}: the solver runs at most {max}"))),
+        Some(t) => Ok(t),
+    }
 }
 
 /// [`refusal`] as refused input (exit code 2).

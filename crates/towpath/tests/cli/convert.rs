@@ -99,3 +99,31 @@ fn refuses_to_overwrite_the_input_and_bad_files() {
     assert!(out.stdout.is_empty());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_matrix_too_large_to_write_and_distances_too_large_to_add_are_refused() {
+    // 5001 points: 25,010,001 costs as a matrix, more than is written (points are fine).
+    let mut text =
+        String::from("NAME: big\nTYPE: TSP\nDIMENSION: 5001\nEDGE_WEIGHT_TYPE: EUC_2D\nNODE_COORD_SECTION\n");
+    for i in 1..=5001 {
+        text.push_str(&format!("{i} {} {}\n", i % 71, i / 71));
+    }
+    let path = scratch_file("big5001.tsp");
+    std::fs::write(&path, &text).unwrap();
+    let (code, _, err) = run(towpath().arg("convert").arg(&path).arg("--matrix"));
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("5001 × 5001") && err.contains("too large"), "{err}");
+    let (code, out, err) = run(towpath().arg("convert").arg(&path));
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("\"points\""));
+    // "9.223372036854776e+18 everywhere" before: refused at reading now.
+    let far = scratch_file("far-convert.tsp");
+    std::fs::write(
+        &far,
+        "NAME: far\nTYPE: TSP\nDIMENSION: 3\nEDGE_WEIGHT_TYPE: EUC_2D\nNODE_COORD_SECTION\n1 0 0\n2 3e19 0\n3 1e19 0\n",
+    )
+    .unwrap();
+    let (code, out, err) = run(towpath().arg("convert").arg(&far).arg("--matrix"));
+    assert_eq!(code, 2, "{err}");
+    assert!(!out.contains("9.223372036854776e18") && err.contains("apart"), "{err}");
+}

@@ -34,25 +34,52 @@ fn afp_args(cmd: &mut Command, d: &Path) {
     cmd.arg("--machine").arg(d.join("gantry-afp.toml")).arg("--dialect").arg(d.join("dialect.toml"));
 }
 
+/// The subcommands `towpath --help` lists (without `help`).
+fn subcommands() -> Vec<String> {
+    let (code, out, err) = run(towpath().arg("--help"));
+    assert_eq!(code, 0, "{err}");
+    let listed = out.split("Commands:").nth(1).expect("a list of commands");
+    let names: Vec<String> = listed
+        .lines()
+        .skip(1)
+        .take_while(|l| !l.trim().is_empty())
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|name| *name != "help")
+        .map(str::to_string)
+        .collect();
+    assert!(names.len() >= 8, "{out}");
+    names
+}
+
 #[test]
 fn every_command_ends_quietly_on_a_closed_stdout() {
+    // Every subcommand is run below; a new one fails this test until it is added.
+    let mut ran: Vec<&str> = Vec::new();
     let d = demo("pipes");
+    closed_stdout(towpath().arg("--help"));
+    closed_stdout(towpath().args(["solve", "--help"]));
+    closed_stdout(towpath().arg("--version"));
+    ran.push("demo");
     closed_stdout(towpath().args(["demo", "--time-limit", "0.05", "--dir"]).arg(d.join("again")));
     assert!(d.join("again/planar-45.opt.nc").exists(), "the demo still wrote its files");
 
     let out = d.join("p45.nc");
+    ran.push("optimize");
     let mut opt = towpath();
     opt.arg("optimize").arg(d.join("planar-45.nc")).args(["--iterations", "200", "-o"]).arg(&out);
     afp_args(&mut opt, &d);
     closed_stdout(&mut opt);
     assert!(out.exists(), "optimize still wrote its output");
 
+    ran.push("verify");
     let mut ver = towpath();
     ver.arg("verify").arg(d.join("planar-45.nc")).arg(&out);
     afp_args(&mut ver, &d);
     closed_stdout(&mut ver);
 
+    ran.extend(["solve", "convert", "route", "layup"]);
     closed_stdout(towpath().arg("solve").arg(data("att48.tsp")).args(["--iterations", "100", "--threads", "1"]));
+    closed_stdout(towpath().arg("solve").arg(data("att48.tsp")).args(["--iterations", "100", "--json"]));
     closed_stdout(towpath().arg("convert").arg(data("att48.tsp")));
     closed_stdout(towpath().arg("route").arg(fixture("rpp_6re.json")).args(["--time-limit", "0.2"]));
     let courses = d.join("c.json");
@@ -62,6 +89,56 @@ fn every_command_ends_quietly_on_a_closed_stdout() {
             .arg(&courses),
     );
     assert!(courses.exists(), "layup still wrote its courses");
+
+    // order prints the ordered drawing when no output is named.
+    ran.push("order");
+    let svg = d.join("strokes.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100" viewBox="0 0 100 100">
+<path id="a" d="M 70 70 L 90 70" stroke="black"/><path id="b" d="M 10 10 L 30 10" stroke="black"/>
+<path id="c" d="M 40 40 L 60 40" stroke="black"/></svg>"#,
+    )
+    .unwrap();
+    closed_stdout(towpath().arg("order").arg(&svg).args(["--iterations", "50"]));
+
+    ran.push("machine");
+    let part = d.join("part.json");
+    std::fs::write(
+        &part,
+        r#"{"format": "towpath-part/1", "origin": [0, 0], "clearance": 5,
+ "features": [{"id": "pocket", "boundary": [[0,0],[80,0],[80,40],[0,40]], "depth": 6}],
+ "tools": [{"number": 1, "radius": 4, "step_over": 3, "features": ["pocket"]}]}"#,
+    )
+    .unwrap();
+    let nc = d.join("part.nc");
+    closed_stdout(towpath().arg("machine").arg(&part).args(["--iterations", "50", "-o"]).arg(&nc));
+    assert!(nc.exists(), "machine still wrote its G-code");
+
+    // A server goes on serving with nobody reading its banner: no panic, no exit.
+    ran.push("serve");
+    let mut child = towpath()
+        .args(["serve", "--port", "0", "--workspace"])
+        .arg(d.join("ws"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    drop(child.stdout.take());
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let early = child.try_wait().unwrap();
+    let _ = child.kill();
+    let _ = child.wait();
+    let mut err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        e.read_to_string(&mut err).unwrap();
+    }
+    assert!(early.is_none() || early.is_some_and(|s| s.success()), "serve ended with {early:?}: {err}");
+    assert!(!err.contains("panicked") && !err.contains("Broken pipe"), "{err}");
+
+    let mut missing = subcommands();
+    missing.retain(|c| !ran.contains(&c.as_str()));
+    assert!(missing.is_empty(), "not run with a closed stdout: {missing:?}");
 }
 
 #[test]
@@ -189,6 +266,56 @@ fn bad_output_paths_are_the_users_error() {
         assert_eq!(code, 2, "{args:?}: {err}");
         assert!(!err.contains("bug"), "{args:?}: {err}");
     }
+}
+
+#[test]
+fn convert_and_route_outputs_where_nothing_may_be_written_exit_2() {
+    let d = scratch("paths2");
+    let att = data("att48.tsp").display().to_string();
+    let graph = fixture("rpp_6re.json").display().to_string();
+    let nowhere = "/proc/towpath-no-such-file.json".to_string();
+    let mut cases: Vec<Vec<String>> = vec![
+        vec!["convert".into(), att.clone(), "-o".into(), nowhere.clone()],
+        vec!["route".into(), graph.clone(), "--time-limit".into(), "0.1".into(), "-o".into(), nowhere.clone()],
+        vec!["route".into(), graph.clone(), "--time-limit".into(), "0.1".into(), "--save-instance".into(), nowhere],
+        vec!["route".into(), graph.clone(), "--time-limit".into(), "0.1".into(), "-o".into(), d.display().to_string()],
+    ];
+    // Permission denied (not testable as root, who may write anywhere).
+    let locked = d.join("locked");
+    std::fs::create_dir_all(&locked).unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o500)).unwrap();
+        if std::fs::write(locked.join("probe"), "x").is_err() {
+            cases.push(vec!["convert".into(), att.clone(), "-o".into(), locked.join("x.json").display().to_string()]);
+            cases.push(vec![
+                "route".into(),
+                graph.clone(),
+                "--time-limit".into(),
+                "0.1".into(),
+                "-o".into(),
+                locked.join("r.json").display().to_string(),
+            ]);
+        }
+    }
+    for args in &cases {
+        let (code, _, err) = run(towpath().args(args));
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(!err.contains("bug") && !err.contains("panicked"), "{args:?}: {err}");
+    }
+    // Missing folders are made.
+    let deep = d.join("new/deeper/att48.json");
+    let (code, _, err) = run(towpath().args(["convert", &att, "-o"]).arg(&deep));
+    assert_eq!(code, 0, "{err}");
+    assert!(deep.exists());
+    let deep = d.join("more/route.json");
+    let (code, _, err) = run(towpath().args(["route", &graph, "--time-limit", "0.1", "-o"]).arg(&deep));
+    assert_eq!(code, 0, "{err}");
+    assert!(deep.exists());
+    // solve writes no file; an input that is a folder is the user's error too.
+    let (code, _, err) = run(towpath().arg("solve").arg(&d));
+    assert_eq!(code, 2, "{err}");
 }
 
 #[test]

@@ -121,3 +121,44 @@ fn every_solver_gives_a_valid_walk() {
     let out = towpath().args(["route", path.to_str().unwrap(), "--solver", "lkh"]).output().unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn generated_sizes_are_bounded_and_said() {
+    for r in ["4294967296", "5001"] {
+        let (code, _, err) = run(towpath().args(["route", "--generate", r, "--time-limit", "1"]));
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("at most 5000"), "{err}");
+        assert!(!err.contains("memory allocation"), "{err}");
+    }
+    let (code, _, err) = run(towpath().args(["route", "--generate", "0"]));
+    assert_eq!(code, 2, "{err}");
+    let (code, _, err) =
+        run(towpath().args(["route", "--generate", "5", "--solver", "ga", "--ga-population", "4000000000"]));
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("(--ga-population)"), "{err}");
+}
+
+#[test]
+fn the_whole_command_honours_its_time_limit() {
+    // 3000 required edges: 6000 shortest-path searches (seconds on two cores; 6.5 s with a
+    // 1 s limit before, 30 s and more on a loaded machine). Either the command finishes within
+    // its limit or it says, within the limit, what the paths need.
+    let t0 = std::time::Instant::now();
+    let (code, out, err) =
+        run(towpath().args(["route", "--generate", "3000", "--time-limit", "0.5", "--threads", "2"]));
+    let took = t0.elapsed().as_secs_f64();
+    match code {
+        0 => assert!(out.contains("verified           : yes"), "{out}"),
+        2 => assert!(err.contains("not done within the time limit") && err.contains("give --time-limit"), "{err}"),
+        _ => panic!("exit {code}: {err}"),
+    }
+    // The limit, plus the generation and process start (generous: a shared machine).
+    assert!(took < 4.0, "took {took:.1} s");
+}
+
+#[test]
+fn the_summary_says_the_route_was_verified() {
+    let (code, out, err) = run(towpath().arg("route").arg(fixture("rpp_6re.json")).args(["--time-limit", "0.2"]));
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("verified           : yes (independent check"), "{out}");
+}

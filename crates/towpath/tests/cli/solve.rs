@@ -158,3 +158,80 @@ fn a_solver_that_cannot_take_the_problem_exits_2() {
     assert_eq!(out.status.code(), Some(2));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Writes `text` to a scratch file and runs `towpath solve` on it with `extra` arguments.
+fn solve_text(name: &str, text: &str, extra: &[&str]) -> (i32, String, String) {
+    let path = scratch_file(name);
+    std::fs::write(&path, text).unwrap();
+    run(towpath().arg("solve").arg(&path).args(extra))
+}
+
+#[test]
+fn a_fixed_edge_is_said_to_make_a_path_not_counted_in_the_cost() {
+    // A 3-node ATSP with the fixed arc 1 -> 3 (issue 17): the answer is the path 3 -> 2 -> 1,
+    // cost c(3,2) + c(2,1) = 1 + 1; the closed tour through 1 -> 3 would add c(1,3) = 100.
+    let text = "NAME: f\nTYPE: ATSP\nDIMENSION: 3\nEDGE_WEIGHT_TYPE: EXPLICIT\nEDGE_WEIGHT_FORMAT: FULL_MATRIX\n\
+EDGE_WEIGHT_SECTION\n0 5 100\n1 0 7\n9 1 0\nFIXED_EDGES_SECTION\n1 3\n-1\nEOF\n";
+    let (code, out, err) = solve_text("fixed.atsp", text, &["--iterations", "10", "--threads", "1"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("cost 2 "), "{out}");
+    assert!(out.contains("route: a path from node 3 to node 1"), "{out}");
+    assert!(out.contains("fixed arc 1 → 3") && out.contains("not counted in the cost"), "{out}");
+    assert!(out.contains("tour: 3 2 1"), "{out}");
+    let (code, out, err) = solve_text("fixed2.atsp", text, &["--iterations", "10", "--threads", "1", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["route"], "path");
+    assert_eq!(v["cost"], 2.0);
+    assert_eq!(v["fixed_edge"], serde_json::json!({"a": 1, "b": 3, "path_from": 3, "path_to": 1, "counted": false}));
+    // Without a fixed edge: a closed tour, no fixed_edge field.
+    let v = solve_json("br17.atsp", &["--iterations", "100"]);
+    assert_eq!(v["route"], "tour");
+    assert!(v.get("fixed_edge").is_none());
+}
+
+#[test]
+fn sizes_taken_on_trust_are_refused_with_their_flag() {
+    let att = data("att48.tsp");
+    let (code, _, err) =
+        run(towpath().arg("solve").arg(&att).args(["--solver", "ga", "--ga-population", "4000000000"]));
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("(--ga-population)") && err.contains("at most"), "{err}");
+    assert!(!err.contains("memory allocation"), "{err}");
+    for threads in ["100000", "0"] {
+        let (code, _, err) = run(towpath().arg("solve").arg(&att).args(["--iterations", "10", "--threads", threads]));
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("--threads"), "{err}");
+    }
+    let (code, _, err) = solve_text("big.tsp", "NAME: big\nTYPE: TSP\nDIMENSION: 5000000000\n", &[]);
+    assert_eq!(code, 2);
+    assert!(err.contains("DIMENSION 5000000000 is too large") && err.contains("4294967294"), "{err}");
+}
+
+#[test]
+fn distances_too_large_to_add_up_are_refused() {
+    // The issue's reproducer: "cost 46116860184273880000 … proven optimal" before.
+    let text = "NAME: far\nTYPE: TSP\nDIMENSION: 5\nEDGE_WEIGHT_TYPE: EUC_2D\nNODE_COORD_SECTION\n\
+1 0 0\n2 3e19 0\n3 1e19 0\n4 4e19 0\n5 2e19 0\nEOF\n";
+    let (code, out, err) = solve_text("far.tsp", text, &["--iterations", "10"]);
+    assert_eq!(code, 2, "{out}{err}");
+    assert!(err.contains("far.tsp:5:") && err.contains("node 1") && err.contains("node 4"), "{err}");
+    // A hundred thousand times smaller it is solved to the true optimum, 2 × 4e14 (there and back).
+    let (code, out, err) = solve_text("near.tsp", &text.replace("e19", "e14"), &["--iterations", "10"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("cost 800000000000000 ") && out.contains("proven optimal"), "{out}");
+}
+
+#[test]
+fn other_commands_inputs_are_pointed_to_their_command() {
+    let program = "%\nN10 G90 G21\nN20 G0 X0 Y0 Z50\nN30 M20\nN40 G1 X100 F3000\nN50 M21\n%\n";
+    for name in ["part.nc", "part.txt"] {
+        let (code, _, err) = solve_text(name, program, &[]);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("AFP program") && err.contains("towpath optimize"), "{err}");
+    }
+    let graph = std::fs::read_to_string(fixture("rpp_6re.json")).unwrap();
+    let (code, _, err) = solve_text("graph.json", &graph, &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("towpath route"), "{err}");
+}

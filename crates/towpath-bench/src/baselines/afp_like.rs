@@ -18,7 +18,8 @@ use std::time::Duration;
 use towpath_baselines::{solve_with, BaselineParams, DohertyParams, PrecedenceSet, SolverName};
 use towpath_seq::{check, End, Metric, Mode, PointCost, Problem, SolveOptions, SolveReport, StateId, Step, TaskId};
 
-use super::{ms, Args};
+use super::Args;
+use crate::stats::ms;
 
 /// Course width, mm.
 const WIDTH: f64 = 101.6;
@@ -141,7 +142,7 @@ fn build(part: &Part) -> anyhow::Result<Built> {
 pub fn run(args: &Args) -> anyhow::Result<String> {
     let towpath_s = if args.quick { 0.2 } else { 1.0 };
     let mut s = String::new();
-    s.push_str("### Seed 000: Doherty et al.'s solver vs towpath on AFP-like parts\n\n");
+    s.push_str("### Doherty et al. (2022): their solver vs towpath on AFP-like parts\n\n");
     s.push_str(&format!(
         "Parts built like the paper's planar test cases (Figs. 7–10): a 2400 × 1200 mm base ply and three \
          500 × 350 mm pad-ups, 101.6 mm courses, programmed ply by ply in an illogical pad-up order and \
@@ -178,7 +179,7 @@ pub fn run(args: &Args) -> anyhow::Result<String> {
             compared(original, &d, &t),
             part.paper_saving
         ));
-        eprintln!("seed 000 part {} done", part.name);
+        eprintln!("Doherty et al. part {} done", part.name);
     }
     s.push('\n');
     s.push_str(&demo_table(towpath_s)?);
@@ -192,10 +193,10 @@ fn demo_table(towpath_s: f64) -> anyhow::Result<String> {
 
     let mut s = String::new();
     s.push_str(&format!(
-        "On `towpath demo`'s parts (the AFP programs of the \"AFP programs (seed 000)\" section, read by \
-         towpath-nc): the route cost is the off-part motion in seed 000's weighted axis distance (approach and \
+        "On `towpath demo`'s parts (the AFP programs of the \"AFP programs (Doherty et al. 2022)\" section, read by \
+         towpath-nc): the route cost is the off-part motion in Doherty et al.'s weighted axis distance (approach and \
          retract included, moves between precedence sets counted), bidirectional, course-level precedence. \
-         `doherty` gets each program's seed-000 precedence sets (§3.1, from the course footprints) and orders set \
+         `doherty` gets each program's Doherty et al. precedence sets (§3.1, from the course footprints) and orders set \
          after set, treating the moves between sets as free, as the paper does; towpath's solver sees only the \
          course-level precedence, {towpath_s} s, one thread. Both from the original order. The programs \
          written from these routes are verified in the AFP section.\n\n"
@@ -224,7 +225,7 @@ fn demo_table(towpath_s: f64) -> anyhow::Result<String> {
             afp.sets.iter().filter(|c| !c.is_empty()).count(),
             compared(original, &d, &t),
         ));
-        eprintln!("seed 000 demo part {} done", part.name);
+        eprintln!("Doherty et al. demo part {} done", part.name);
     }
     s.push('\n');
     Ok(s)

@@ -1,48 +1,15 @@
-//! The AFP benchmark: seed 000's test parts and a 100-ply, 10,000-course panel, optimized and
-//! verified, beside seed 000's own solver (`doherty`); prints a Markdown table and, with
-//! `--write FILE`, puts it into that file under the heading "## AFP programs (seed 000)". Run
-//! through `bench/afp.sh`.
-//!
-//! Usage: `afp_bench [--runs N] [--time-limit S] [--big-time-limit S] [--plies P] [--courses C]
-//! [--write BENCHMARKS.md]`
+//! `towpath-bench afp`: Doherty et al.'s (2022) test parts and a 100-ply, 10,000-course panel,
+//! optimized and verified, beside Doherty et al.'s own solver (`doherty`); prints a Markdown
+//! table and, with `--write FILE`, puts it into that file under the heading
+//! "## AFP programs (Doherty et al. 2022)". Run through `bench/afp.sh`.
 
 use std::time::{Duration, Instant};
+
+use crate::stats::{cpu_seconds, duration as ms, median, write_section};
 
 use towpath_machine::CostKind;
 use towpath_nc::demo::{demo_parts, gantry, stacked_panel, TOW_WIDTH};
 use towpath_nc::{optimize, AfpOptions, Dialect, OptimizeOptions, SolverName, Width};
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    let m = v.len() / 2;
-    if v.len() % 2 == 1 {
-        v[m]
-    } else {
-        (v[m - 1] + v[m]) / 2.0
-    }
-}
-
-/// A time in seconds as milliseconds or seconds, whichever reads better.
-fn ms(seconds: f64) -> String {
-    if seconds < 0.1 {
-        format!("{:.1} ms", seconds * 1e3)
-    } else {
-        format!("{seconds:.2} s")
-    }
-}
-
-/// CPU time (user + system) of this process so far, seconds, from /proc (Linux).
-fn cpu_seconds() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else { return f64::NAN };
-    let after = stat.rsplit_once(')').map_or("", |x| x.1);
-    let f: Vec<&str> = after.split_whitespace().collect();
-    // Fields 14 and 15 of stat are utime and stime; after the command name they are 12 and 13.
-    let ticks = |i: usize| f.get(i).and_then(|x| x.parse::<f64>().ok()).unwrap_or(f64::NAN);
-    (ticks(11) + ticks(12)) / 100.0
-}
 
 /// One run on the large part.
 struct BigRun {
@@ -55,56 +22,59 @@ struct BigRun {
     lines: usize,
 }
 
-struct Args {
+/// Arguments of `towpath-bench afp`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Runs per demo part (median).
+    #[arg(long, default_value_t = 5)]
     runs: usize,
+    /// Solver time limit per run on the demo parts, seconds.
+    #[arg(long, default_value_t = 1.0)]
     time_limit: f64,
+    /// Solver time limit per run on the large panel, seconds.
+    #[arg(long, default_value_t = 2.0)]
     big_time_limit: f64,
+    /// Plies of the large panel.
+    #[arg(long, default_value_t = 100)]
     plies: usize,
+    /// Courses per ply of the large panel.
+    #[arg(long, default_value_t = 100)]
     courses: usize,
+    /// Runs on the large panel.
+    #[arg(long, default_value_t = 3)]
     big_runs: u64,
-    write: Option<String>,
+    /// Write the table into this Markdown file, replacing its section (or appending one).
+    #[arg(long, value_name = "FILE")]
+    write: Option<std::path::PathBuf>,
 }
 
-fn args() -> Args {
-    let mut a =
-        Args { runs: 5, time_limit: 1.0, big_time_limit: 2.0, plies: 100, courses: 100, big_runs: 3, write: None };
-    let v: Vec<String> = std::env::args().skip(1).collect();
-    let mut i = 0;
-    while i < v.len() {
-        let next = v.get(i + 1).cloned().unwrap_or_default();
-        match v[i].as_str() {
-            "--runs" => a.runs = next.parse().expect("--runs N"),
-            "--time-limit" => a.time_limit = next.parse().expect("--time-limit S"),
-            "--big-time-limit" => a.big_time_limit = next.parse().expect("--big-time-limit S"),
-            "--plies" => a.plies = next.parse().expect("--plies P"),
-            "--courses" => a.courses = next.parse().expect("--courses C"),
-            "--big-runs" => a.big_runs = next.parse().expect("--big-runs N"),
-            "--write" => a.write = Some(next),
-            other => panic!("unknown argument {other}"),
+/// The heading of this benchmark's section in `BENCHMARKS.md`.
+const HEADING: &str = "## AFP programs (Doherty et al. 2022)";
+
+/// Runs the benchmark.
+pub fn run(a: Args) -> anyhow::Result<()> {
+    for (flag, t) in [("--time-limit", a.time_limit), ("--big-time-limit", a.big_time_limit)] {
+        if !(t.is_finite() && (0.0..=86_400.0).contains(&t)) {
+            anyhow::bail!("{flag}: give a time from 0 to one day, not {t}");
         }
-        i += 2;
     }
-    a
-}
-
-fn main() {
-    let a = args();
     let dialect = Dialect::default();
     let mut md = String::new();
-    md.push_str("## AFP programs (seed 000)\n\n");
+    md.push_str(HEADING);
+    md.push_str("\n\n");
     md.push_str(&format!(
         "Regenerate with `bench/afp.sh` (release build; {} runs per part, median; solver time limit {} s per \
-         run, all cores). Parts: `towpath demo`'s, modelled on seed 000 §4.5 (programs planned badly on \
-         purpose: plies out of order, every course laid in the same direction). towpath optimizes seed 000's \
+         run, all cores). Parts: `towpath demo`'s, modelled on Doherty et al.'s §4.5 (programs planned badly on \
+         purpose: plies out of order, every course laid in the same direction). towpath optimizes Doherty et al.'s \
          weighted axis distance (`--cost axis`), bidirectional, course-level precedence; savings are measured \
          by the independent verifier on the written programs. *Off-part* counts every move outside roller \
-         contact, including approach, retract and moves between precedence sets (seed 000 counts moves \
-         between sets as free); *total* adds the on-part motion, both as tool-point distance. Seed 000's \
+         contact, including approach, retract and moves between precedence sets (Doherty et al. count moves \
+         between sets as free); *total* adds the on-part motion, both as tool-point distance. Doherty et al.'s \
          figures are from its §4.5 (its part geometry and machine weights are not published, so the parts \
          are analogous, not identical).\n\n",
         a.runs, a.time_limit
     ));
-    md.push_str("| part | courses | seed 000 off-part | seed 000 total | towpath off-part (axis) | towpath off-part (tool) | towpath total (tool) | towpath unidirectional off-part (axis) | towpath off-part time, optimizing time | doherty (seed-000 algorithm) off-part (axis) | doherty solve | towpath off-part (axis) at doherty's solve time | towpath solve | time per run |\n");
+    md.push_str("| part | courses | Doherty et al. off-part | Doherty et al. total | towpath off-part (axis) | towpath off-part (tool) | towpath total (tool) | towpath unidirectional off-part (axis) | towpath off-part time, optimizing time | doherty (Doherty et al.'s algorithm) off-part (axis) | doherty solve | towpath off-part (axis) at doherty's solve time | towpath solve | time per run |\n");
     md.push_str("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for part in demo_parts().into_iter().filter(|_| a.runs > 0) {
         let mut off_axis = Vec::new();
@@ -189,16 +159,16 @@ fn main() {
             part.name,
             p(so),
             p(st),
-            p(median(off_axis)),
-            p(median(off_tool)),
-            p(median(total_tool)),
-            p(median(uni)),
-            p(median(time_opt)),
-            p(median(doherty)),
-            ms(median(doherty_secs)),
-            p(median(short)),
-            ms(median(solve_secs)),
-            median(secs)
+            p(median(&off_axis)),
+            p(median(&off_tool)),
+            p(median(&total_tool)),
+            p(median(&uni)),
+            p(median(&time_opt)),
+            p(median(&doherty)),
+            ms(median(&doherty_secs)),
+            p(median(&short)),
+            ms(median(&solve_secs)),
+            median(&secs)
         );
         eprint!("{row}");
         md.push_str(&row);
@@ -232,7 +202,7 @@ fn main() {
             lines: o.program.lines.len(),
         });
     }
-    let m = |f: &dyn Fn(&BigRun) -> f64| median(rows.iter().map(f).collect());
+    let m = |f: &dyn Fn(&BigRun) -> f64| median(&rows.iter().map(f).collect::<Vec<_>>());
     let (courses, edges, lines) = rows.first().map_or((0, 0, 0), |r| (r.courses, r.edges, r.lines));
     md.push_str(&format!(
         "\n**Large part:** a stacked panel of {} plies (0°/45°/−45°/90°, each ply over all earlier ones) with {courses} \
@@ -262,9 +232,9 @@ fn main() {
          off-part time.\n",
     );
     md.push_str(&format!(
-        "\nThe doherty columns run seed 000's own algorithm (§3.2: seed pool, nearest neighbour, depth-first then \
+        "\nThe doherty columns run Doherty et al.'s own algorithm (§3.2: seed pool, nearest neighbour, depth-first then \
          breadth-first search; `towpath optimize --solver doherty`, crate towpath-baselines) on the same problem: \
-         axis cost, bidirectional, the same course-level precedence, with the part's seed-000 precedence sets \
+         axis cost, bidirectional, the same course-level precedence, with the part's Doherty et al. precedence sets \
          (§3.1) as its sets, one thread; its route is rewritten and verified like towpath's. As in the paper it \
          treats moves between precedence sets as free while searching; the saving shown counts them. *doherty \
          solve* is its solver time (deterministic; median of {} runs); *towpath … at doherty's solve time* runs \
@@ -274,22 +244,8 @@ fn main() {
         a.runs
     ));
     print!("{md}");
-    if let Some(path) = a.write {
-        let old = std::fs::read_to_string(&path).unwrap_or_else(|_| "# Benchmarks\n".to_string());
-        let new = replace_section(&old, "## AFP programs (seed 000)", &md);
-        std::fs::write(&path, new).expect("write the benchmark file");
-        eprintln!("written to {path}");
+    if let Some(path) = &a.write {
+        write_section(path, HEADING, &md)?;
     }
-}
-
-/// Replaces the section starting at `heading` (up to the next `## ` heading) or appends it.
-fn replace_section(doc: &str, heading: &str, section: &str) -> String {
-    match doc.find(heading) {
-        Some(start) => {
-            let rest = &doc[start + heading.len()..];
-            let end = rest.find("\n## ").map_or(doc.len(), |e| start + heading.len() + e + 1);
-            format!("{}{}{}", &doc[..start], section, &doc[end..])
-        }
-        None => format!("{}\n{}", doc.trim_end_matches('\n').to_string() + "\n", section),
-    }
+    Ok(())
 }

@@ -6,7 +6,8 @@ use towpath_baselines::{solve_with, AcoParams, BaselineParams, GaParams, SolverN
 use towpath_coverage::{seed004_like, RppModel, TABLE_I_SIZES};
 use towpath_seq::SolveOptions;
 
-use super::{median, ms, Args};
+use super::Args;
+use crate::stats::{median, ms};
 
 /// One row of seed 004's Table I: path lengths (m) and ACO2's time (s; `None` is "< 0.01").
 struct PaperRow {
@@ -74,7 +75,7 @@ pub fn run(args: &Args) -> anyhow::Result<String> {
             aco_vs_ga: Vec::new(),
         };
         for s in 1..=seeds {
-            let model = RppModel::new(seed004_like(r, s))?;
+            let model = RppModel::new(seed004_like(r, s)?)?;
             let p = model.problem();
             let mut inst: Vec<Vec<(f64, f64)>> = vec![Vec::new(); 3 + limits.len()];
             for k in 1..=runs {
@@ -125,7 +126,7 @@ pub fn run(args: &Args) -> anyhow::Result<String> {
                 res.runs[i].extend(v);
             }
         }
-        eprintln!("seed 004 size {v} v / {r} re done");
+        eprintln!("Tewolde & Sheng size {v} v / {r} re done");
         results.push(res);
     }
     Ok(markdown(args, &results, seeds, runs))
@@ -142,7 +143,7 @@ fn markdown(args: &Args, results: &[SizeResult], seeds: u64, runs: u64) -> Strin
         }
     };
     let mut s = String::new();
-    s.push_str("### Seed 004: GA vs ACO vs towpath on the open rural postman problem\n\n");
+    s.push_str("### Tewolde & Sheng (2008): GA vs ACO vs towpath on the open rural postman problem\n\n");
     s.push_str(&format!(
         "Instances: `seed004_like(R, seed)` (towpath-coverage), shaped like the paper's Table I sample data \
          (|V| = 2|R|, patch paths as required edges, lengths in metres), {seeds} instances per size, {runs} \

@@ -13,7 +13,8 @@ use towpath_baselines::{solve_with, BaselineParams, SolverName};
 use towpath_formats::{read_instance, with_problem};
 use towpath_seq::SolveOptions;
 
-use super::{median, ms, Args};
+use super::Args;
+use crate::stats::{median, ms};
 
 /// The GTSP-LIB instances of the table (files `gtsp/gtsplib/NAME.gtsp`).
 const GTSPLIB: [&str; 5] = ["11berlin52", "20kroA100", "40kroa200", "89pcb442", "157rat783"];
@@ -131,8 +132,8 @@ fn row(path: &Path, best: Option<(f64, String)>, seconds: f64, threads: usize, r
 }
 
 /// Runs the table and returns its Markdown.
-pub fn run(args: &Args) -> anyhow::Result<String> {
-    let data = args.data.clone();
+pub fn run(args: &Args, data: &Path) -> anyhow::Result<String> {
+    let data = data.to_path_buf();
     let seconds = if args.quick { 0.3 } else { args.gtsp_seconds };
     let runs = if args.quick { 1 } else { args.runs.max(1) };
     let threads = args.gtsp_threads.max(1);
@@ -144,7 +145,7 @@ pub fn run(args: &Args) -> anyhow::Result<String> {
         .chain(pcglns.iter().map(|&n| (n, format!("pcgtsp/{n}.pcglns"))))
         .collect();
     let mut s = String::new();
-    s.push_str("### Seed 003: Castelino et al.'s GTSP→TSP transformation vs towpath's direct search\n\n");
+    s.push_str("### Castelino et al. (2003): their GTSP→TSP transformation vs towpath's direct search\n\n");
     s.push_str(&format!(
         "GTSP-LIB files ({}) and the ten PCGLNS files (Salman et al.'s precedence-constrained GTSPs derived \
          from TSPLIB SOP instances), read from `{}` with towpath-formats. `castelino` transforms each instance \
@@ -166,7 +167,7 @@ pub fn run(args: &Args) -> anyhow::Result<String> {
     for (name, rel) in &files {
         let best = best_known(&data, name, rel)?;
         s.push_str(&row(&data.join(rel), best, seconds, threads, runs)?);
-        eprintln!("seed 003 {name} done");
+        eprintln!("Castelino et al. {name} done");
     }
     s.push('\n');
     Ok(s)

@@ -1,8 +1,8 @@
-//! Benchmark driver for `bench/layup.py` (run by hand, not in CI):
+//! `towpath-bench layup`: the driver of `bench/layup.py` (run by hand, not in CI):
 //!
-//! `cargo run --release -p towpath-layup --example layup_bench -- OUT_DIR [REPEATS]`
+//! `cargo run --release -p towpath-bench -- layup OUT_DIR [--repeats N]`
 //!
-//! 1. Accuracy study in the form of seed 001 Tables 2–3 on analytic surfaces (cylinder, sphere,
+//! 1. Accuracy study in the form of Xiao et al.'s (2020) Tables 2–3 on analytic surfaces (cylinder, sphere,
 //!    cone) for a grid of D_l2s × L_seg: tessellation + trace time, distance deviation split into
 //!    normal and geodesic parts, angle deviation. Printed as JSON (`accuracy.json`).
 //! 2. 200k-triangle cylinder and sphere meshes (OBJ) with deterministic start points and
@@ -12,7 +12,10 @@
 //! 4. A 2 m² doubly curved NURBS mold tessellated to about 200k triangles (`dome.stl`) for the
 //!    full-ply timing through the CLI.
 
+use std::path::PathBuf;
 use std::time::Instant;
+
+use crate::stats::median;
 
 use glam::DVec3;
 use serde_json::json;
@@ -23,14 +26,6 @@ use towpath_layup::boundary::Region;
 use towpath_layup::field::{DirectionField, Rosette};
 use towpath_layup::ply::{plan, PlySpec};
 use towpath_layup::trace::{trace_both, walk, Located, Steering, WalkOptions};
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v[v.len() / 2]
-}
 
 /// Small deterministic generator (xorshift) so starts are the same in every run.
 struct Rng(u64);
@@ -43,11 +38,21 @@ impl Rng {
     }
 }
 
-fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let out = std::path::PathBuf::from(args.get(1).cloned().unwrap_or_else(|| "bench/out".into()));
-    let repeats: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(5);
-    std::fs::create_dir_all(&out).expect("output directory");
+/// Arguments of `towpath-bench layup`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Folder for the results (JSON, meshes), made if missing.
+    #[arg(value_name = "OUT_DIR", default_value = "bench/out")]
+    out: PathBuf,
+    /// Timed repeats per trace (median).
+    #[arg(long, default_value_t = 5)]
+    repeats: usize,
+}
+
+/// Runs the benchmark.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let (out, repeats) = (args.out, args.repeats.max(1));
+    std::fs::create_dir_all(&out).map_err(|e| anyhow::anyhow!("{}: cannot make the folder: {e}", out.display()))?;
 
     // 1. Accuracy study.
     let cases = [
@@ -58,7 +63,9 @@ fn main() {
     let mut rows = Vec::new();
     for (name, desc, p0, d0, field_course) in cases {
         let s = Analytic::parse(desc).expect("surface");
-        for (mode, smooth) in [("smooth normals, midpoint", true), ("face normals, entry point (seed 001)", false)] {
+        for (mode, smooth) in
+            [("smooth normals, midpoint", true), ("face normals, entry point (Xiao et al. 2020)", false)]
+        {
             for d_l2s in [0.05, 0.2, 0.5, 1.0] {
                 for l_seg in [10.0, 20.0, 65.0, 110.0] {
                     let t0 = Instant::now();
@@ -136,7 +143,7 @@ fn main() {
                 per.push(t0.elapsed().as_secs_f64());
                 pts = w;
             }
-            times.push(median(per));
+            times.push(median(&per));
             let mut line = vec![loc.p.to_array()];
             line.extend(pts.iter().map(|q| q.p.to_array()));
             polylines.push(line);
@@ -149,7 +156,7 @@ fn main() {
             .expect("json"),
         )
         .expect("write");
-        eprintln!("{name}: {} triangles, median {:.3} ms per 1 m trace", mesh.num_faces(), 1e3 * median(times.clone()));
+        eprintln!("{name}: {} triangles, median {:.3} ms per 1 m trace", mesh.num_faces(), 1e3 * median(&times));
     }
 
     // 3. ±45° field plies on the 200k cylinder against the exact design direction.
@@ -211,4 +218,5 @@ fn main() {
     let (mesh, _) = Mesh::build(&soup, &BuildOptions::default()).expect("mesh");
     io::write_path(&out.join("dome.stl"), &mesh.to_soup()).expect("write");
     eprintln!("dome: {} triangles, {:.3} m2", mesh.num_faces(), mesh.area() / 1e6);
+    Ok(())
 }
