@@ -6,6 +6,7 @@ pub mod bench_baselines;
 pub mod convert;
 pub mod demo;
 pub mod layup;
+pub mod layup_report;
 pub mod machine;
 pub mod optimize;
 pub mod order;

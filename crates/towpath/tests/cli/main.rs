@@ -5,6 +5,7 @@ mod afp;
 mod common;
 mod convert;
 mod layup;
+mod layup_report;
 mod machine;
 mod order;
 mod outputs_and_pipes;
