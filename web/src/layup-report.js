@@ -5,7 +5,7 @@
 
 import * as THREE from 'three';
 import { View } from './viewer.js';
-import { categorical, diverging, ramp, rampCss, css } from './colors.js';
+import { categorical, ramp, rampCss, css } from './colors.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -36,7 +36,8 @@ function niceFloor(x) {
 function fmt(x) {
   if (!Number.isFinite(x)) return String(x);
   const a = Math.abs(x);
-  if (a >= 1000 || a === 0) return x.toFixed(0);
+  if (a < 1e-6) return '0';
+  if (a >= 1000) return x.toFixed(0);
   return Number(x.toPrecision(3)).toString();
 }
 
@@ -91,12 +92,12 @@ function gapAt(c, s) {
   return near.length ? c.gw[near[0]] : NaN;
 }
 
-/** Every laid tow as a band (90 % of the tow width, so tows read as stripes), and each course's
- *  outer edges as lines. Per vertex: course index and the three figures. */
+/** Every laid tow as a band of its width (so per-tow cuts and restarts show), and each course's
+ *  outer edges as dark lines. Per vertex: course index and the three figures. */
 function buildCourses(data) {
   const w = data.tow_width, nt = data.tows;
   const lift = Math.max(0.02 * w, data.diagonal * 2e-5);
-  const pos = [], idx = [], vCourse = [], vAngle = [], vRadius = [], vGap = [];
+  const pos = [], nor = [], idx = [], vCourse = [], vAngle = [], vRadius = [], vGap = [];
   const edges = [];
   const courses = data.courses.map(course);
   courses.forEach((c, ci) => {
@@ -112,9 +113,10 @@ function buildCourses(data) {
         const right = [], left = [];
         for (const s of ss) {
           const st = station(c, s);
-          for (const side of [-0.45, 0.45]) {
+          for (const side of [-0.5, 0.5]) {
             const o = mid + side * w;
             pos.push(st.p[0] + st.l[0] * o + st.n[0] * lift, st.p[1] + st.l[1] * o + st.n[1] * lift, st.p[2] + st.l[2] * o + st.n[2] * lift);
+            nor.push(st.n[0], st.n[1], st.n[2]);
             vCourse.push(ci); vAngle.push(st.angle); vRadius.push(st.radius); vGap.push(st.gap);
           }
           const e = (o, arr) => arr.push(st.p[0] + st.l[0] * o + st.n[0] * lift * 2, st.p[1] + st.l[1] * o + st.n[1] * lift * 2, st.p[2] + st.l[2] * o + st.n[2] * lift * 2);
@@ -131,17 +133,31 @@ function buildCourses(data) {
   });
   const g = new THREE.BufferGeometry();
   g.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
+  g.setAttribute('normal', new THREE.Float32BufferAttribute(nor, 3));
   g.setAttribute('color', new THREE.Float32BufferAttribute(new Float32Array(pos.length), 3));
   g.setIndex(idx);
-  const bands = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ vertexColors: true, side: THREE.DoubleSide }));
+  // Depth: the mesh is pushed furthest back, the bands a little, the edge lines not at all, so
+  // lines win over bands and bands over the mesh at any distance.
+  const bands = new THREE.Mesh(g, new THREE.MeshLambertMaterial({
+    vertexColors: true, side: THREE.DoubleSide, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 2,
+  }));
   const eg = new THREE.BufferGeometry();
   eg.setAttribute('position', new THREE.Float32BufferAttribute(edges, 3));
   const lines = new THREE.LineSegments(eg, new THREE.LineBasicMaterial({ color: 0x10151b }));
   return { bands, lines, values: { course: vCourse, angle: vAngle, radius: vRadius, gap: vGap }, count: courses.length };
 }
 
-const NO_VALUE = [0.6, 0.63, 0.67];
+const NO_VALUE = [0.3, 0.31, 0.34];
 const FLAG = [0.86, 0.1, 0.12];
+const GAP = [[0.16, 0.38, 0.95], [0.3, 0.74, 0.42], [0.92, 0.22, 0.18]];
+
+/** Gap (t = −1, blue) through a butt joint (0, green) to overlap (+1, red): no end of it is grey,
+ *  so it never reads as the bare mesh. */
+function gapColor(t) {
+  const x = Math.max(-1, Math.min(1, t));
+  const [a, b] = x < 0 ? [GAP[1], GAP[0]] : [GAP[1], GAP[2]];
+  return a.map((v, k) => v + (b[k] - v) * Math.abs(x));
+}
 
 /** Colour scales: a function of a vertex's value, and the legend that explains it. */
 function scales(data) {
@@ -154,7 +170,7 @@ function scales(data) {
   return {
     course: {
       color: (v) => categorical(v),
-      legend: `<div class="small">${ncourses} course${ncourses === 1 ? '' : 's'}, one colour each; tows drawn at 90 % of their width (${fmt(data.tow_width)} mm), so each course shows as ${data.tows} stripe${data.tows === 1 ? '' : 's'}; dark lines: course edges.</div>`,
+      legend: `<div class="small">${ncourses} course${ncourses === 1 ? '' : 's'}, one colour each, every tow (${data.tows} × ${fmt(data.tow_width)} mm) drawn where it is laid; dark lines: course edges; bare grey: mesh not covered.</div>`,
     },
     angle: {
       color: (v) => (Number.isFinite(v) ? ramp(v / angleMax) : NO_VALUE),
@@ -173,9 +189,9 @@ function scales(data) {
         <div class="small muted"><span class="swatch" style="background:${css(FLAG)}"></span>below the minimum steering radius ${fmt(limit)} mm: ${q.points_below_min_radius} point${q.points_below_min_radius === 1 ? '' : 's'}${q.min_steering_radius ? `; smallest ${fmt(q.min_steering_radius)} mm` : '; every course straight'}</div>`,
     },
     gap: {
-      color: (v) => (Number.isFinite(v) ? diverging(-v / gapMax) : NO_VALUE),
-      legend: `<div class="ramp" style="background:linear-gradient(90deg, ${css(diverging(-1))}, ${css(diverging(0))}, ${css(diverging(1))})"></div>
-        <div class="ends"><span>gap ${fmt(gapMax)} mm</span><span>0</span><span>overlap ${fmt(gapMax)} mm</span></div>
+      color: (v) => (Number.isFinite(v) ? gapColor(-v / gapMax) : NO_VALUE),
+      legend: `<div class="ramp" style="background:linear-gradient(90deg, ${css(gapColor(-1))}, ${css(gapColor(0))}, ${css(gapColor(1))})"></div>
+        <div class="ends"><span>gap ${fmt(gapMax)} mm</span><span>0 (butt joint)</span><span>overlap ${fmt(gapMax)} mm</span></div>
         <div class="small muted">width of the gap or overlap between each course and its left neighbour, mm (widest gap ${fmt(q.max_gap)} mm, widest overlap ${fmt(q.max_overlap)} mm); <span class="swatch" style="background:${css(NO_VALUE)}"></span>no neighbour</div>`,
     },
   };
@@ -209,6 +225,9 @@ function init() {
     return;
   }
   view.renderer.setClearColor(0x1b2129);
+  // More ambient light than the app's view: faces turned to the camera show the legend's colours
+  // nearly as they are, and the shading still shows the part's shape.
+  view.scene.add(new THREE.AmbientLight(0xffffff, 1.1));
   const positions = decode(data.mesh.positions, Float32Array);
   const triangles = decode(data.mesh.triangles, Uint32Array);
   const mg = new THREE.BufferGeometry();
@@ -220,7 +239,7 @@ function init() {
   data.diagonal = box.getSize(new THREE.Vector3()).length();
   const mesh = new THREE.Mesh(mg, new THREE.MeshStandardMaterial({
     color: 0xd4d8dc, roughness: 0.9, metalness: 0, side: THREE.DoubleSide,
-    polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
+    polygonOffset: true, polygonOffsetFactor: 2, polygonOffsetUnits: 4,
   }));
   view.scene.add(mesh);
   const built = buildCourses(data);
@@ -271,7 +290,8 @@ function init() {
   view.controls.addEventListener('change', overlay);
   new ResizeObserver(overlay).observe($('viewport'));
 
-  const fit = () => { view.fit(box); overlay(); };
+  // The floor grid sits clearly below the part, so depth offsets never draw it over a flat ply.
+  const fit = () => { view.fit(box); view.grid.position.z = box.min.z - 0.01 * data.diagonal; overlay(); };
   fit();
   window.addEventListener('keydown', (e) => { if (e.key === 'f' || e.key === 'F') fit(); });
   $('color-mode').addEventListener('change', (e) => setMode(e.target.value));
