@@ -184,13 +184,19 @@ fn data_json(result: &LayupResult, tows: usize) -> anyhow::Result<String> {
     let mesh = &result.mesh;
     let ply = &result.ply;
     let triangles: Vec<u8> = mesh.triangles().iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+    // The ply's figures without its timings: the page holds no clock, so a run gives the same page.
+    let mut summary = output::summary(ply);
+    if let Some(o) = summary.as_object_mut() {
+        o.remove("seconds");
+        o.remove("timings");
+    }
     let data = Data {
         format: "towpath-layup-report",
         version: 1,
         units: "mm",
         tow_width: result.tow_width_mm,
         tows,
-        summary: output::summary(ply),
+        summary,
         mesh: MeshData {
             vertex_count: mesh.positions().len(),
             triangle_count: mesh.num_faces(),

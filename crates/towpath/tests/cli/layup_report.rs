@@ -200,7 +200,7 @@ fn the_report_is_listed_deterministic_and_refused_under_a_wrong_name() {
         assert!(!d.join("r.json").exists(), "{extra:?} wrote the courses");
     };
     refuse(&["--report", "r.txt"], "r.txt: --report writes an HTML page; name it .html");
-    refuse(&["--report", "r.json"], "would be the same file");
+    refuse(&["--report", "r.json"], "r.json: --report writes an HTML page");
     refuse(&["--gcode", "x.html", "--report", "x.html"], "would be the same file");
     std::fs::copy(d.join("a/p.stl"), d.join("m.html")).unwrap();
     let (code, _, err) = layup_in(
