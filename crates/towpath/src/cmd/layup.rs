@@ -23,13 +23,14 @@ use towpath_layup::request::{
 use towpath_layup::section::Coverage;
 use towpath_layup::units::Units;
 
+use super::layup_report;
 use crate::files::Files;
 use crate::{exit, outln};
 
 /// Arguments of `towpath layup`.
 #[derive(clap::Args, Debug)]
 #[command(
-    after_help = "Examples:\n  towpath layup cylinder:r=300,l=1000 --angle 45 --axis 0,0,1 --tow-width 6.35 --tows 16 -o courses.json\n  towpath layup mold.stl --angle 0 --guide spine.csv --boundary ply1.csv --tow-width 6.35 --tows 8 --coverage 100 -o ply1.json --gcode ply1.nc\n  towpath layup wing.stl --units ft --tow-width 0.25in --tows 16 --angle 45 -o wing.json\n\nLengths (surface, curves, points, tolerances, radii) are in --units (default mm); --tow-width may carry its own unit. Outputs are in mm.\nThe run stops with an error at --time-limit (default 300 s); nothing is written then. Warnings (implausible sizes or units, poor coverage, large overlaps) go to standard error."
+    after_help = "Examples:\n  towpath layup cylinder:r=300,l=1000 --angle 45 --axis 0,0,1 --tow-width 6.35 --tows 16 -o courses.json\n  towpath layup mold.stl --angle 0 --guide spine.csv --boundary ply1.csv --tow-width 6.35 --tows 8 --coverage 100 -o ply1.json --gcode ply1.nc --report ply1.html\n  towpath layup wing.stl --units ft --tow-width 0.25in --tows 16 --angle 45 -o wing.json\n\nLengths (surface, curves, points, tolerances, radii) are in --units (default mm); --tow-width may carry its own unit. Outputs are in mm.\nThe run stops with an error at --time-limit (default 300 s); nothing is written then. Warnings (implausible sizes or units, poor coverage, large overlaps) go to standard error."
 )]
 pub struct Args {
     /// Mold surface: a mesh file (.stl, .obj, .ply) or an analytic description such as
@@ -99,6 +100,11 @@ pub struct Args {
     /// Also write the (tessellated, welded) mesh (.stl, .obj or .ply).
     #[arg(long)]
     pub write_mesh: Option<PathBuf>,
+    /// Also write a self-contained HTML page (.html) with the mesh and every course in 3D,
+    /// coloured by course, angle deviation, steering radius or gap/overlap, and the summary.
+    /// Opens offline in a browser: nothing in it is fetched.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
     /// Ply number in the G-code program.
     #[arg(long, default_value_t = 1)]
     pub ply_number: usize,
@@ -386,6 +392,20 @@ fn write_outputs(
         files.write(path, io::write_bytes(&result.mesh.to_soup(), format)?)?;
         written.push((path.clone(), "mesh, mm"));
     }
+    if let Some(path) = &args.report {
+        written.push((path.clone(), "HTML report"));
+        let title = format!("{}: {} deg ply, {} courses", args.surface, meta.angle_deg, ply.courses.len());
+        let warnings: Vec<String> = result.warnings.iter().map(|w| w.to_string()).collect();
+        let list: Vec<(String, &'static str)> =
+            written.iter().map(|(p, what)| (p.display().to_string(), *what)).collect();
+        let page = layup_report::Page {
+            title: &title,
+            rows: &summary_rows(args, result, meta),
+            warnings: &warnings,
+            files: &list,
+        };
+        files.write(path, layup_report::html(&page, result, args.tows)?)?;
+    }
     Ok(written)
 }
 
@@ -413,70 +433,106 @@ fn units_line(args: &Args, result: &LayupResult) -> String {
     }
 }
 
-fn print_table(args: &Args, result: &LayupResult, meta: &Meta, written: &[(PathBuf, &'static str)], t0: Instant) {
+/// The summary's rows from the surface to the angle deviation (label, value), shared by the
+/// table on stdout and the HTML report.
+fn summary_rows(args: &Args, result: &LayupResult, meta: &Meta) -> Vec<(&'static str, String)> {
     let (mesh, ply, r) = (&result.mesh, &result.ply, &result.repair);
     let q = &ply.quality;
-    outln!(
-        "towpath layup: {} ({}, {})",
-        args.surface,
-        plural(mesh.num_faces(), "triangle", "triangles"),
-        plural(mesh.positions().len(), "vertex", "vertices")
-    );
-    outln!("  units           : {}", units_line(args, result));
+    let mut rows = Vec::new();
+    rows.push((
+        "surface",
+        format!(
+            "{} ({}, {})",
+            args.surface,
+            plural(mesh.num_faces(), "triangle", "triangles"),
+            plural(mesh.positions().len(), "vertex", "vertices")
+        ),
+    ));
+    rows.push(("units", units_line(args, result)));
     if r.vertices_in != r.vertices_out {
-        outln!(
-            "  welding         : {} → {} vertices (tolerance {} mm)",
-            r.vertices_in,
-            r.vertices_out,
-            sig(r.weld_tolerance)
-        );
+        rows.push((
+            "welding",
+            format!("{} → {} vertices (tolerance {} mm)", r.vertices_in, r.vertices_out, sig(r.weld_tolerance)),
+        ));
     }
     if r.degenerate_removed + r.duplicates_removed + r.flipped + r.non_manifold_edges + r.orientation_conflicts > 0 {
-        outln!(
-            "  repairs         : {} degenerate and {} duplicate triangles removed, {} flipped, {} non-manifold and {} non-orientable edges cut",
-            r.degenerate_removed, r.duplicates_removed, r.flipped, r.non_manifold_edges, r.orientation_conflicts
-        );
+        rows.push((
+            "repairs",
+            format!(
+                "{} degenerate and {} duplicate triangles removed, {} flipped, {} non-manifold and {} non-orientable edges cut",
+                r.degenerate_removed, r.duplicates_removed, r.flipped, r.non_manifold_edges, r.orientation_conflicts
+            ),
+        ));
     }
-    outln!(
-        "  ply             : {} deg ({}), {} × {} mm tows ({} mm course), coverage rule {} %, {} method",
-        meta.angle_deg,
-        meta.direction_source,
-        args.tows,
-        sig(result.tow_width_mm),
-        sig(result.tow_width_mm * args.tows as f64),
-        meta.coverage_percent,
-        match meta.method {
-            Method::Field => "field",
-            Method::Parallel => "parallel",
-            Method::Natural => "natural",
-        }
-    );
-    outln!(
-        "  courses         : {} (N1 = {} left, N2 = {} right; section estimate {} / {})",
-        ply.courses.len(),
-        ply.n1,
-        ply.n2,
-        ply.n_estimate[0],
-        ply.n_estimate[1]
-    );
-    outln!("  coverage        : {:.2} % of {} mm²", q.coverage_percent, sig(q.ply_area));
+    rows.push((
+        "ply",
+        format!(
+            "{} deg ({}), {} × {} mm tows ({} mm course), coverage rule {} %, {} method",
+            meta.angle_deg,
+            meta.direction_source,
+            args.tows,
+            sig(result.tow_width_mm),
+            sig(result.tow_width_mm * args.tows as f64),
+            meta.coverage_percent,
+            match meta.method {
+                Method::Field => "field",
+                Method::Parallel => "parallel",
+                Method::Natural => "natural",
+            }
+        ),
+    ));
+    rows.push((
+        "courses",
+        format!(
+            "{} (N1 = {} left, N2 = {} right; section estimate {} / {})",
+            ply.courses.len(),
+            ply.n1,
+            ply.n2,
+            ply.n_estimate[0],
+            ply.n_estimate[1]
+        ),
+    ));
+    rows.push(("coverage", format!("{:.2} % of {} mm²", q.coverage_percent, sig(q.ply_area))));
     // Rounding noise (a millionth of the ply, a micrometre) is no gap or overlap.
     let area = |a: f64| if a < 1e-6 * q.ply_area { "0".to_string() } else { sig(a) };
     let width = |w: f64| if w < 1e-3 { "0".to_string() } else { sig(w) };
-    outln!(
-        "  gaps / overlaps : {} / {} mm² (widest {} / {} mm)",
-        area(q.gap_area),
-        area(q.overlap_area),
-        width(q.max_gap),
-        width(q.max_overlap)
-    );
-    outln!(
-        "  steering        : min radius {} (limit {} mm, {} below)",
-        q.min_steering_radius.map_or("straight".to_string(), |r| format!("{} mm", sig(r))),
-        sig(q.min_steering_radius_limit),
-        plural(q.points_below_min_radius, "point", "points")
-    );
-    outln!("  angle deviation : mean {:.3} deg, max {:.3} deg", q.mean_angle_deviation_deg, q.max_angle_deviation_deg);
+    rows.push((
+        "gaps / overlaps",
+        format!(
+            "{} / {} mm² (widest {} / {} mm)",
+            area(q.gap_area),
+            area(q.overlap_area),
+            width(q.max_gap),
+            width(q.max_overlap)
+        ),
+    ));
+    rows.push((
+        "steering",
+        format!(
+            "min radius {} (limit {} mm, {} below)",
+            q.min_steering_radius.map_or("straight".to_string(), |r| format!("{} mm", sig(r))),
+            sig(q.min_steering_radius_limit),
+            plural(q.points_below_min_radius, "point", "points")
+        ),
+    ));
+    rows.push((
+        "angle deviation",
+        format!("mean {:.3} deg, max {:.3} deg", q.mean_angle_deviation_deg, q.max_angle_deviation_deg),
+    ));
+    rows
+}
+
+fn print_table(args: &Args, result: &LayupResult, meta: &Meta, written: &[(PathBuf, &'static str)], t0: Instant) {
+    let mut rows = summary_rows(args, result, meta);
+    // The first row is the heading line.
+    if !rows.is_empty() {
+        let (_, surface) = rows.remove(0);
+        outln!("towpath layup: {surface}");
+    }
+    for (label, value) in rows {
+        outln!("  {label:<16}: {value}");
+    }
+    let ply = &result.ply;
     if !result.warnings.is_empty() {
         outln!("  warnings        : {} (on standard error)", result.warnings.len());
     }
@@ -543,7 +599,7 @@ fn declare_files(args: &Args) -> anyhow::Result<Files> {
         ext.filter(|e| ["csv", "nc", "gcode", "ngc", "tap", "stl", "obj", "ply", "html", "htm"].contains(&e.as_str()))
     {
         return Err(exit::bad_input(anyhow!(
-            "{}: -o writes the courses as JSON, not .{e}; name it .json (G-code: --gcode, CSV: --csv, mesh: --write-mesh)",
+            "{}: -o writes the courses as JSON, not .{e}; name it .json (G-code: --gcode, CSV: --csv, mesh: --write-mesh, 3D page: --report)",
             args.output.display()
         )));
     }
@@ -556,6 +612,16 @@ fn declare_files(args: &Args) -> anyhow::Result<Files> {
     if let Some(p) = &args.write_mesh {
         mesh_format(p)?;
         files.output("written mesh", p)?;
+    }
+    if let Some(p) = &args.report {
+        let ext = p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        if !matches!(ext.as_deref(), Some("html" | "htm")) {
+            return Err(exit::bad_input(anyhow!(
+                "{}: --report writes an HTML page; name it .html (courses JSON: -o, G-code: --gcode, CSV: --csv)",
+                p.display()
+            )));
+        }
+        files.output("HTML report", p)?;
     }
     Ok(files)
 }

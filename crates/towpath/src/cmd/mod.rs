@@ -4,6 +4,7 @@ mod afp_common;
 pub mod convert;
 pub mod demo;
 pub mod layup;
+pub mod layup_report;
 pub mod machine;
 pub mod optimize;
 pub mod order;

@@ -7,6 +7,7 @@ mod common;
 mod convert;
 mod cycle_time;
 mod layup;
+mod layup_report;
 mod machine;
 mod order;
 mod outputs_and_pipes;
