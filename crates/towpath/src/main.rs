@@ -36,6 +36,9 @@ enum Command {
     Route(cmd::route::Args),
     /// Run a benchmark and print (or write into BENCHMARKS.md) its tables.
     Bench(cmd::bench::Args),
+    /// Plan spray forming or painting: flat patches, passes, one robot path and the predicted
+    /// thickness (Tewolde & Sheng 2008).
+    Spray(Box<cmd::spray::Args>),
 }
 
 fn main() {
@@ -49,6 +52,7 @@ fn main() {
         Command::Verify(args) => cmd::verify::run(args),
         Command::Route(args) => cmd::route::run(args),
         Command::Bench(args) => cmd::bench::run(args),
+        Command::Spray(args) => cmd::spray::run(*args),
     };
     std::process::exit(exit::report(result));
 }

@@ -10,4 +10,5 @@ pub mod optimize;
 pub mod route;
 pub mod solve;
 pub mod solver_args;
+pub mod spray;
 pub mod verify;

@@ -8,3 +8,4 @@ mod layup;
 mod outputs_and_pipes;
 mod route;
 mod solve;
+mod spray;
