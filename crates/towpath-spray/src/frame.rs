@@ -11,7 +11,8 @@
 //!   bend the normal), outside by extending the surface in the tangent plane at the nearest border
 //!   point, keeping the point's projection.
 //! - [`Frame::line_intervals`]: where a line of the plane runs over the patch or within the
-//!   run-out band of its free and crease edges.
+//!   run-out band of its free and crease edges (measured square to each edge, with the wedge at
+//!   a convex corner between two such edges filled).
 
 use std::collections::HashMap;
 
@@ -33,6 +34,9 @@ pub enum EdgeKind {
     /// Another patch continuing the surface (normals less than 10° apart).
     Seam,
 }
+
+/// What `patch_of` answers in [`Frame::of_faces`] for a face whose edges count as free.
+pub const ABSORBED: u32 = u32::MAX;
 
 /// Normals further apart than this across an edge make it a crease.
 pub const CREASE_DEG: f64 = 10.0;
@@ -103,6 +107,8 @@ pub struct Frame<'m> {
     segs: RTree<Seg>,
     /// Previous and next edge of every border edge in its loop (`usize::MAX` at a broken chain).
     links: Vec<(usize, usize)>,
+    /// Half-planes (point, inward normal) that bound each run-out band where it meets a seam.
+    clips: Vec<Vec<(DVec2, DVec2)>>,
     /// Projected area of the patch.
     pub area2: f64,
     /// Area-weighted centroid in the plane.
@@ -127,21 +133,26 @@ pub fn plane_axes(n: DVec3) -> (DVec3, DVec3) {
 
 impl<'m> Frame<'m> {
     /// The frame of patch `patch` of a partition; free and sharp edges get a run-out of
-    /// `overrun` mm, milder creases a share of it growing with the angle.
-    pub fn new(mesh: &'m Mesh, partition: &Partition, patch: u32, overrun: f64) -> Frame<'m> {
+    /// `overrun` mm, milder creases a share of it growing with the angle. Edges to a patch
+    /// marked in `absorbed` (too small to get passes of its own) count as free: passes run over
+    /// it.
+    pub fn new(mesh: &'m Mesh, partition: &Partition, patch: u32, overrun: f64, absorbed: &[bool]) -> Frame<'m> {
         let p = &partition.patches[patch as usize];
-        Frame::of_faces(
-            mesh,
-            &p.faces,
-            p.normal,
-            &|g| partition.patch_of[g as usize] == patch,
-            &|g| partition.patch_of[g as usize],
-            overrun,
-        )
+        let member = |g: u32| partition.patch_of[g as usize] == patch;
+        let other = |g: u32| {
+            let q = partition.patch_of[g as usize];
+            if absorbed.get(q as usize).copied().unwrap_or(false) {
+                ABSORBED
+            } else {
+                q
+            }
+        };
+        Frame::of_faces(mesh, &p.faces, p.normal, &member, &other, overrun)
     }
 
     /// The frame of any face set with mean normal `normal`; `member(g)` says whether face g is in
-    /// the set, `patch_of(g)` names the patch of a face outside it.
+    /// the set, `patch_of(g)` names the patch of a face outside it ([`ABSORBED`]: treat the edge
+    /// as free).
     pub fn of_faces(
         mesh: &'m Mesh,
         faces: &[u32],
@@ -183,16 +194,17 @@ impl<'m> Frame<'m> {
                 if g != NO_FACE && member(g) {
                     continue;
                 }
-                let (kind, ext, neighbor) = if g == NO_FACE {
+                let across = if g == NO_FACE { ABSORBED } else { patch_of(g) };
+                let (kind, ext, neighbor) = if across == ABSORBED {
                     (EdgeKind::Free, overrun, u32::MAX)
                 } else {
                     let ang = mesh.face_normal(f).dot(mesh.face_normal(g)).clamp(-1.0, 1.0).acos().to_degrees();
                     if ang < CREASE_DEG {
-                        (EdgeKind::Seam, 0.0, patch_of(g))
+                        (EdgeKind::Seam, 0.0, across)
                     } else {
                         let share = ((1.0 - ang.to_radians().cos()) / (1.0 - FULL_RUNOUT_DEG.to_radians().cos()))
                             .clamp(0.0, 1.0);
-                        (EdgeKind::Crease, overrun * share, patch_of(g))
+                        (EdgeKind::Crease, overrun * share, across)
                     }
                 };
                 let (va, vb) = (t[k], t[(k + 1) % 3]);
@@ -240,6 +252,7 @@ impl<'m> Frame<'m> {
                 }
             }
         }
+        let clips = seam_clips(&border, &links);
         let segs = RTree::bulk_load(
             border
                 .iter()
@@ -259,6 +272,7 @@ impl<'m> Frame<'m> {
             loops,
             segs,
             links,
+            clips,
             area2,
             centroid,
             moments,
@@ -332,10 +346,23 @@ impl<'m> Frame<'m> {
                 cuts.push((e.a + (e.b - e.a) * t).dot(dir));
             }
             if e.ext > 0.0 {
-                let prev_ext = self.prev_ext(i);
-                let next_ext = self.next_ext(i);
-                if let Some(iv) = capsule_interval(e.a, e.b, e.ext, dir, c, prev_ext, next_ext) {
+                let clip = |iv: (f64, f64)| -> Option<(f64, f64)> {
+                    let (mut lo, mut hi) = iv;
+                    for &(o, n) in &self.clips[i] {
+                        slab(&mut lo, &mut hi, (m * c - o).dot(n), dir.dot(n), 0.0, f64::INFINITY);
+                    }
+                    (lo < hi).then_some((lo, hi))
+                };
+                if let Some(iv) = band_interval(e.a, e.b, e.ext, dir, c).and_then(clip) {
                     ivs.push(iv);
+                }
+                // The wedge a convex corner leaves between this band and the next one.
+                let nx = self.links[i].1;
+                if nx != usize::MAX && self.border[nx].ext > 0.0 {
+                    let f = &self.border[nx];
+                    if let Some(iv) = wedge_interval(e.b, e.ext.max(f.ext), e.b - e.a, f.b - f.a, dir, c).and_then(clip) {
+                        ivs.push(iv);
+                    }
                 }
             }
         }
@@ -344,13 +371,6 @@ impl<'m> Frame<'m> {
             ivs.push((w[0], w[1]));
         }
         merge_intervals(ivs)
-    }
-
-    fn prev_ext(&self, i: usize) -> bool {
-        self.links[i].0 != usize::MAX && self.border[self.links[i].0].ext > 0.0
-    }
-    fn next_ext(&self, i: usize) -> bool {
-        self.links[i].1 != usize::MAX && self.border[self.links[i].1].ext > 0.0
     }
 
     /// Extent of the patch along plane direction `m`: (min, max) of border points' p·m.
@@ -389,6 +409,58 @@ fn seg_distance(q: DVec2, a: DVec2, b: DVec2) -> f64 {
     q.distance(a + ab * s)
 }
 
+/// Where a run-out edge meets a seam, the band past the run-out edge must stop at the seam's
+/// continuation (the neighbour's band stops there too, from the other side): the half-plane on
+/// the patch's side of the line through the corner along the seam's chord over one run-out
+/// length. Every band within twice its run-out of the corner is bounded by it.
+fn seam_clips(border: &[BorderEdge], links: &[(usize, usize)]) -> Vec<Vec<(DVec2, DVec2)>> {
+    let mut corners: Vec<(DVec2, DVec2)> = Vec::new();
+    let reach = border.iter().map(|e| e.ext).fold(0.0, f64::max);
+    if !(reach > 0.0) {
+        return vec![Vec::new(); border.len()];
+    }
+    for (i, e) in border.iter().enumerate() {
+        if e.ext > 0.0 {
+            continue;
+        }
+        let (prev, next) = links[i];
+        if prev != usize::MAX && border[prev].ext > 0.0 {
+            // The seam starts at e.a: its direction from there, forwards.
+            let (mut j, mut len, mut p) = (i, 0.0, e.a);
+            while j != usize::MAX && border[j].ext == 0.0 && len < reach {
+                len += border[j].a.distance(border[j].b);
+                p = border[j].b;
+                j = links[j].1;
+            }
+            if let Some(u) = (p - e.a).try_normalize() {
+                corners.push((e.a, u.perp()));
+            }
+        }
+        if next != usize::MAX && border[next].ext > 0.0 {
+            // The seam ends at e.b: its direction arriving there.
+            let (mut j, mut len, mut p) = (i, 0.0, e.b);
+            while j != usize::MAX && border[j].ext == 0.0 && len < reach {
+                len += border[j].a.distance(border[j].b);
+                p = border[j].a;
+                j = links[j].0;
+            }
+            if let Some(u) = (e.b - p).try_normalize() {
+                corners.push((e.b, u.perp()));
+            }
+        }
+    }
+    border
+        .iter()
+        .map(|e| {
+            if e.ext > 0.0 {
+                corners.iter().copied().filter(|&(o, _)| seg_distance(o, e.a, e.b) <= 2.0 * e.ext).collect()
+            } else {
+                Vec::new()
+            }
+        })
+        .collect()
+}
+
 /// Border edges chained into loops: each edge followed by an edge starting at its end vertex.
 fn chain_loops(border: &[BorderEdge]) -> Vec<Vec<usize>> {
     let mut starts: HashMap<u32, Vec<usize>> = HashMap::new();
@@ -421,58 +493,54 @@ fn chain_loops(border: &[BorderEdge]) -> Vec<Vec<usize>> {
     loops
 }
 
-/// The interval of the line `{p·m = c}` (m = dir.perp()) within distance `r` of segment ab:
-/// the rectangle around the segment, plus the round caps at ends whose neighbouring edge also
-/// has a run-out (at a free–seam corner the band ends square with the edge).
-fn capsule_interval(a: DVec2, b: DVec2, r: f64, dir: DVec2, c: f64, cap_a: bool, cap_b: bool) -> Option<(f64, f64)> {
-    let m = dir.perp();
-    let mut lo = f64::INFINITY;
-    let mut hi = f64::NEG_INFINITY;
-    let mut disk = |o: DVec2| {
-        let off = o.dot(m) - c;
-        if off.abs() < r {
-            let h = (r * r - off * off).sqrt();
-            let s = o.dot(dir);
-            lo = lo.min(s - h);
-            hi = hi.max(s + h);
+/// Narrows `[lo, hi]` to the parameters s where `min ≤ base + s·slope ≤ max`.
+fn slab(lo: &mut f64, hi: &mut f64, base: f64, slope: f64, min: f64, max: f64) {
+    if slope.abs() < 1e-15 {
+        if base < min || base > max {
+            *lo = f64::INFINITY;
+            *hi = f64::NEG_INFINITY;
         }
-    };
-    if cap_a {
-        disk(a);
+    } else {
+        let (t0, t1) = ((min - base) / slope, (max - base) / slope);
+        *lo = lo.max(t0.min(t1));
+        *hi = hi.min(t0.max(t1));
     }
-    if cap_b {
-        disk(b);
-    }
+}
+
+/// The interval of the line `{p·m = c}` (m = dir.perp(), p = c·m + s·dir) within distance `r`
+/// of segment ab, measured square to the segment (the rectangle along it, no round ends).
+fn band_interval(a: DVec2, b: DVec2, r: f64, dir: DVec2, c: f64) -> Option<(f64, f64)> {
     let ab = b - a;
     let len = ab.length();
-    if len > 0.0 {
-        let u = ab / len;
-        let w = u.perp();
-        // Points p = p0 + s·dir with p0 = c·m: constraints 0 ≤ (p−a)·u ≤ len and |(p−a)·w| ≤ r.
-        let p0 = m * c;
-        let mut s_lo = f64::NEG_INFINITY;
-        let mut s_hi = f64::INFINITY;
-        let mut slab = |base: f64, slope: f64, min: f64, max: f64| {
-            // min ≤ base + s·slope ≤ max
-            if slope.abs() < 1e-15 {
-                if base < min || base > max {
-                    s_lo = f64::INFINITY;
-                    s_hi = f64::NEG_INFINITY;
-                }
-            } else {
-                let (t0, t1) = ((min - base) / slope, (max - base) / slope);
-                s_lo = s_lo.max(t0.min(t1));
-                s_hi = s_hi.min(t0.max(t1));
-            }
-        };
-        slab((p0 - a).dot(u), dir.dot(u), 0.0, len);
-        slab((p0 - a).dot(w), dir.dot(w), -r, r);
-        if s_lo <= s_hi {
-            lo = lo.min(s_lo);
-            hi = hi.max(s_hi);
-        }
+    if !(len > 0.0) {
+        return None;
     }
+    let u = ab / len;
+    let w = u.perp();
+    let p0 = dir.perp() * c;
+    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+    slab(&mut lo, &mut hi, (p0 - a).dot(u), dir.dot(u), 0.0, len);
+    slab(&mut lo, &mut hi, (p0 - a).dot(w), dir.dot(w), -r, r);
     (lo <= hi).then_some((lo, hi))
+}
+
+/// The interval of the line within distance `r` of corner `o` and in the wedge past the end of
+/// the edge arriving along `u1` and before the start of the edge leaving along `u2`: the part
+/// of the round cap that the two bands leave uncovered at a convex corner (empty where the
+/// edges are collinear).
+fn wedge_interval(o: DVec2, r: f64, u1: DVec2, u2: DVec2, dir: DVec2, c: f64) -> Option<(f64, f64)> {
+    let m = dir.perp();
+    let off = o.dot(m) - c;
+    if !(off.abs() < r) {
+        return None;
+    }
+    let h = (r * r - off * off).sqrt();
+    let so = o.dot(dir);
+    let (mut lo, mut hi) = (so - h, so + h);
+    let p0 = m * c;
+    slab(&mut lo, &mut hi, (p0 - o).dot(u1), dir.dot(u1), 0.0, f64::INFINITY);
+    slab(&mut lo, &mut hi, (p0 - o).dot(u2), dir.dot(u2), f64::NEG_INFINITY, 0.0);
+    (lo < hi).then_some((lo, hi))
 }
 
 /// Sorts and merges overlapping intervals; drops empty ones.
@@ -494,20 +562,23 @@ mod tests {
     use super::*;
 
     #[test]
-    fn capsule_interval_of_a_horizontal_band() {
+    fn band_and_corner_intervals() {
         // Segment along x from 0 to 10, radius 2; lines along x at y = c.
         let (a, b) = (DVec2::ZERO, DVec2::new(10.0, 0.0));
         let dir = DVec2::X; // m = (0, 1)
-        let iv = capsule_interval(a, b, 2.0, dir, 1.0, true, true).unwrap();
-        let h = (4.0f64 - 1.0).sqrt();
-        assert!((iv.0 + h).abs() < 1e-12 && (iv.1 - 10.0 - h).abs() < 1e-12, "{iv:?}");
-        let iv = capsule_interval(a, b, 2.0, dir, 1.0, false, false).unwrap();
+        let iv = band_interval(a, b, 2.0, dir, 1.0).unwrap();
         assert!((iv.0).abs() < 1e-12 && (iv.1 - 10.0).abs() < 1e-12, "{iv:?}");
-        assert!(capsule_interval(a, b, 2.0, dir, 2.5, true, true).is_none());
+        assert!(band_interval(a, b, 2.0, dir, 2.5).is_none());
         // A line across the segment (along y at x = 4): |y| ≤ 2.
-        let iv = capsule_interval(a, b, 2.0, DVec2::Y, -4.0, true, true).unwrap();
-        // m = Y.perp() = (-1, 0): p·m = -x = c → x = 4
+        let iv = band_interval(a, b, 2.0, DVec2::Y, -4.0).unwrap();
         assert!((iv.0 + 2.0).abs() < 1e-12 && (iv.1 - 2.0).abs() < 1e-12, "{iv:?}");
+        // Convex corner at (10, 0), the next edge going up (+y): the wedge is x ≥ 10, y ≤ 0.
+        let h = (4.0f64 - 1.0).sqrt();
+        let iv = wedge_interval(b, 2.0, DVec2::X, DVec2::Y, dir, -1.0).unwrap();
+        assert!((iv.0 - 10.0).abs() < 1e-12 && (iv.1 - 10.0 - h).abs() < 1e-12, "{iv:?}");
+        assert!(wedge_interval(b, 2.0, DVec2::X, DVec2::Y, dir, 1.0).is_none());
+        // Collinear edges leave no wedge.
+        assert!(wedge_interval(b, 2.0, DVec2::X, DVec2::X, dir, -1.0).is_none());
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! Plans how a spray robot covers a part to a target thickness, as evenly as possible, with the
 //! least travel, after Tewolde & Sheng (2008) (§II–III, Fig. 3): divide and conquer.
 //!
-//! 1. [`partition`]: the part is split into hole-free, nearly convex cells (topology) and then
+//! 1. [`partition`](mod@partition): the part is split into hole-free, nearly convex cells (topology) and then
 //!    into flat patches by region growing under a maximum deviation angle β_th; the patches form
 //!    an adjacency graph.
 //! 2. [`passes`]: each patch gets zigzag passes along the sweep direction with the fewest turns,
@@ -17,7 +17,7 @@
 //! 4. [`path`]: the poses with time stamps; [`thickness`]: the predicted thickness on the part
 //!    from any path; [`output`]: the path file, CSV, thickness PLY and summary.
 //!
-//! [`plan`] runs steps 1–4. Lengths are in mm, times in s, thickness in µm, flow in mm³/s.
+//! [`plan()`] runs steps 1–4. Lengths are in mm, times in s, thickness in µm, flow in mm³/s.
 
 // `!(a > b)` is used on purpose: it is also true when a or b is NaN, which input checks rely on.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

@@ -47,6 +47,8 @@ pub enum Pattern {
     Spiral,
     /// Plane slices through the whole part, no partition (the plain plane-slicer baseline).
     Slicer,
+    /// No passes of its own: a sliver sprayed by its neighbours' run-outs.
+    Absorbed,
 }
 
 impl std::fmt::Display for Pattern {
@@ -55,6 +57,7 @@ impl std::fmt::Display for Pattern {
             Pattern::Zigzag => "zigzag",
             Pattern::Spiral => "spiral",
             Pattern::Slicer => "slicer",
+            Pattern::Absorbed => "absorbed",
         })
     }
 }
@@ -88,9 +91,16 @@ pub struct Pass {
     /// Gun axes (unit, towards the surface).
     #[serde(skip)]
     pub axes: Vec<DVec3>,
+    /// The points aimed at: where the axis meets the surface (or its extension past an edge),
+    /// one standoff from the gun.
+    #[serde(skip)]
+    pub targets: Vec<DVec3>,
     /// Length of the gun's path (mm).
     pub length: f64,
-    /// Gun speed (mm/s).
+    /// Length of the aimed path on the surface (mm).
+    pub target_length: f64,
+    /// Speed of the aimed point along the surface (mm/s); the gun moves faster over convex
+    /// surfaces, slower over concave ones.
     pub speed: f64,
     /// Direction changes sharper than 45° inside the pass.
     pub turns: usize,
@@ -149,12 +159,16 @@ impl PassParams {
 pub(crate) struct Geom {
     pub positions: Vec<DVec3>,
     pub axes: Vec<DVec3>,
+    pub targets: Vec<DVec3>,
     pub closed: bool,
 }
 
 impl Geom {
     fn length(&self) -> f64 {
         self.positions.windows(2).map(|w| w[0].distance(w[1])).sum()
+    }
+    fn target_length(&self) -> f64 {
+        self.targets.windows(2).map(|w| w[0].distance(w[1])).sum()
     }
     fn turns(&self) -> usize {
         let p = &self.positions;
@@ -182,10 +196,18 @@ pub(crate) struct Planned {
 }
 
 impl Planned {
+    /// A plan with no passes.
+    pub fn empty() -> Planned {
+        Planned { pattern: Pattern::Zigzag, direction: None, spacing: 0.0, speed: 0.0, geoms: Vec::new() }
+    }
+
     /// Spray time plus [`TURN_SECONDS`] per pass end and inner turn.
     pub fn estimate(&self) -> f64 {
-        let len: f64 = self.geoms.iter().map(Geom::length).sum();
+        let len: f64 = self.geoms.iter().map(Geom::target_length).sum();
         let turns: usize = self.geoms.iter().map(|g| 1 + g.turns()).sum();
+        if self.geoms.is_empty() {
+            return 0.0;
+        }
         len / self.speed + turns as f64 * TURN_SECONDS
     }
 }
@@ -194,12 +216,14 @@ impl Planned {
 fn poses(frame: &Frame, pts: &[DVec2], h: f64, closed: bool) -> Geom {
     let mut positions = Vec::with_capacity(pts.len());
     let mut axes = Vec::with_capacity(pts.len());
+    let mut targets = Vec::with_capacity(pts.len());
     for &q in pts {
         let (p, n, _) = frame.lift(q);
         positions.push(p + n * h);
         axes.push(-n);
+        targets.push(p);
     }
-    Geom { positions, axes, closed }
+    Geom { positions, axes, targets, closed }
 }
 
 /// Points every `step` or less from a to b, both included.
@@ -227,30 +251,35 @@ impl Lines {
 fn lines_for(frame: &Frame, dir: DVec2, params: &PassParams) -> Lines {
     let m = dir.perp();
     let (lo, hi) = frame.extent(m);
-    let width = hi - lo;
     let g = &params.gun;
     let d0 = params.spacing.unwrap_or(params.optimum.spacing);
+    let e = frame.max_ext();
+    // Spacing is measured on the surface: along the line across the passes through the
+    // centroid, offsets map to arc length.
+    let arc = ArcMap::new(frame, m, dir.dot(frame.centroid) * dir, lo - e - 2.0 * d0, hi + e + 2.0 * d0);
+    let (slo, shi) = (arc.s(lo), arc.s(hi));
+    let width = shi - slo;
     let (seam_lo, seam_hi) = (seam_side(frame, m, lo, d0), seam_side(frame, m, hi, d0));
     // The lattice starts half a spacing inside a seam side, so that the neighbour's lattice
     // continues it; with seams on both sides an optimised spacing is fitted to the width.
     let (d, anchor) = match (params.spacing, seam_lo, seam_hi) {
-        (None, true, true) => (spacing::fit(&g.profile, g.radius, width, d0).1, lo),
+        (None, true, true) => (spacing::fit(&g.profile, g.radius, width, d0).1, slo),
         (_, false, true) => {
             let n = (width / d0).floor();
-            (d0, hi - n * d0 - d0)
+            (d0, shi - n * d0 - d0)
         }
-        _ => (d0, lo),
+        _ => (d0, slo),
     };
-    let e = frame.max_ext();
-    let kmin = ((lo - e - anchor) / d - 0.5).floor() as i64;
-    let kmax = ((hi + e - anchor) / d - 0.5).ceil() as i64;
+    let kmin = ((slo - e - anchor) / d - 0.5).floor() as i64;
+    let kmax = ((shi + e - anchor) / d - 0.5).ceil() as i64;
     let min_len = 1e-3 * g.radius;
     let mut lines = Vec::new();
     for k in kmin..=kmax {
-        let c = anchor + (k as f64 + 0.5) * d;
-        if !(c > lo - e - 1e-9 && c < hi + e + 1e-9) {
+        let cs = anchor + (k as f64 + 0.5) * d;
+        if !(cs > slo - e - 1e-9 && cs < shi + e + 1e-9) {
             continue;
         }
+        let c = arc.x(cs);
         let ivs: Vec<(f64, f64)> =
             frame.line_intervals(dir, c).into_iter().filter(|iv| iv.1 - iv.0 > min_len).collect();
         if !ivs.is_empty() {
@@ -258,6 +287,49 @@ fn lines_for(frame: &Frame, dir: DVec2, params: &PassParams) -> Lines {
         }
     }
     Lines { dir, spacing: d, lines }
+}
+
+/// Arc length on the surface along a line of the projection plane, as a function of the
+/// plane coordinate: piecewise linear through lifted samples.
+struct ArcMap {
+    xs: Vec<f64>,
+    ss: Vec<f64>,
+}
+
+impl ArcMap {
+    /// Samples the line `base + x·m` for x from `x0` to `x1`.
+    fn new(frame: &Frame, m: DVec2, base: DVec2, x0: f64, x1: f64) -> ArcMap {
+        let n = 256;
+        let xs: Vec<f64> = (0..=n).map(|i| x0 + (x1 - x0) * i as f64 / n as f64).collect();
+        let pts: Vec<DVec3> = xs.iter().map(|&x| frame.lift(base + m * x).0).collect();
+        let mut ss = vec![x0];
+        for i in 1..pts.len() {
+            // Never shorter than the projection (keeps the map strictly increasing).
+            let step = pts[i].distance(pts[i - 1]).max(xs[i] - xs[i - 1]);
+            ss.push(ss[i - 1] + step);
+        }
+        ArcMap { xs, ss }
+    }
+    fn interp(from: &[f64], to: &[f64], v: f64) -> f64 {
+        let n = from.len();
+        if v <= from[0] {
+            return to[0] + (v - from[0]);
+        }
+        if v >= from[n - 1] {
+            return to[n - 1] + (v - from[n - 1]);
+        }
+        let k = from.partition_point(|&a| a <= v).clamp(1, n - 1);
+        let (a, b) = (from[k - 1], from[k]);
+        to[k - 1] + (to[k] - to[k - 1]) * (v - a) / (b - a)
+    }
+    /// Arc length at plane coordinate x.
+    fn s(&self, x: f64) -> f64 {
+        Self::interp(&self.xs, &self.ss, x)
+    }
+    /// Plane coordinate at arc length s.
+    fn x(&self, s: f64) -> f64 {
+        Self::interp(&self.ss, &self.xs, s)
+    }
 }
 
 /// Whether the border near the extreme `x` (along plane direction `m`, within one spacing) is
@@ -417,7 +489,7 @@ pub(crate) fn spiral(frame: &Frame, params: &PassParams) -> Option<Planned> {
     }
     let d = match params.spacing {
         Some(d) => d,
-        None => inner_max / ((inner_max / d0).round().max(1.0)),
+        None => spacing::fit(&params.gun.profile, params.gun.radius, inner_max, d0).1,
     };
     let mut levels = Vec::new();
     let mut k = 0;
@@ -595,10 +667,12 @@ pub(crate) fn finish(planned: &Planned, patch: u32, first_id: u32) -> Vec<Pass> 
             patch,
             closed: g.closed,
             length: g.length(),
+            target_length: g.target_length(),
             speed: planned.speed,
             turns: g.turns(),
             positions: g.positions.clone(),
             axes: g.axes.clone(),
+            targets: g.targets.clone(),
         })
         .collect()
 }

@@ -10,7 +10,7 @@ use crate::sequence::Sequenced;
 /// Totals of a path.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct PathTotals {
-    /// Length sprayed (mm).
+    /// Length sprayed, measured along the aimed points on the surface (mm).
     pub spray_length_mm: f64,
     /// Length travelled with the spray off (mm).
     pub travel_mm: f64,
@@ -23,15 +23,9 @@ pub struct PathTotals {
     pub spray_time_s: f64,
 }
 
-/// Builds the poses of a sequenced plan. Passes run at their speed (a turn of the gun in place
-/// as if its aim point moved the arc at the standoff), transits at `travel_speed` (mm/s).
-pub fn assemble(
-    passes: &[Pass],
-    seq: &Sequenced,
-    home: Option<DVec3>,
-    travel_speed: f64,
-    standoff: f64,
-) -> (Vec<Pose>, PathTotals) {
+/// Builds the poses of a sequenced plan. On passes the aimed point moves at the pass speed,
+/// transits run at `travel_speed` (mm/s).
+pub fn assemble(passes: &[Pass], seq: &Sequenced, home: Option<DVec3>, travel_speed: f64) -> (Vec<Pose>, PathTotals) {
     let mut poses: Vec<Pose> = Vec::new();
     let mut totals = PathTotals::default();
     let mut t = 0.0;
@@ -62,15 +56,16 @@ pub fn assemble(
             }
         }
         let mut prev = p.positions[first];
-        let mut prev_axis = p.axes[first];
+        let mut prev_target = p.targets[first];
         for (j, &i) in order.iter().enumerate() {
             let pos = p.positions[i];
             if j > 0 {
+                // The speed is that of the aimed point along the surface.
                 let d = prev.distance(pos);
-                let turn = prev_axis.dot(p.axes[i]).clamp(-1.0, 1.0).acos();
-                let dt = d.max(turn * standoff) / p.speed;
+                let aim = prev_target.distance(p.targets[i]);
+                let dt = if aim > 0.0 { aim } else { d } / p.speed;
                 t += dt;
-                totals.spray_length_mm += d;
+                totals.spray_length_mm += aim;
                 totals.spray_time_s += dt;
             }
             let spray = j + 1 < order.len();
@@ -86,7 +81,7 @@ pub fn assemble(
                 poses.push(pose);
             }
             prev = pos;
-            prev_axis = p.axes[i];
+            prev_target = p.targets[i];
         }
         totals.turns += p.turns;
     }

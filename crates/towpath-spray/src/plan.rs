@@ -177,23 +177,19 @@ pub fn plan(mesh: &Mesh, params: &SprayParams) -> Result<SprayPlan, SprayError> 
             scale: gun.radius,
         };
         let part = partition::partition(mesh, &opts);
+        let absorbed = absorbed(&part, gun.radius);
         let planned: Vec<Option<(Planned, Option<f64>)>> = part
             .patches
             .par_iter()
             .map(|p| {
-                let frame = Frame::new(mesh, &part, p.id, overrun);
+                if absorbed[p.id as usize] {
+                    return Some((Planned { pattern: Pattern::Absorbed, ..Planned::empty() }, None));
+                }
+                let frame = Frame::new(mesh, &part, p.id, overrun, &absorbed);
                 plan_patch(&frame, &pp, params.pattern)
             })
             .collect();
-        let planned = planned
-            .into_iter()
-            .map(|p| {
-                p.unwrap_or((
-                    Planned { pattern: Pattern::Zigzag, direction: None, spacing: 0.0, speed: 0.0, geoms: Vec::new() },
-                    None,
-                ))
-            })
-            .collect();
+        let planned = planned.into_iter().map(|p| p.unwrap_or((Planned::empty(), None))).collect();
         (part, planned)
     };
     let t_part = t0.elapsed().as_secs_f64();
@@ -220,7 +216,7 @@ pub fn plan(mesh: &Mesh, params: &SprayParams) -> Result<SprayPlan, SprayError> 
     let t2 = Instant::now();
     let clearance = Clearance::new(mesh, gun.standoff);
     let sequenced = sequence(&passes, params.home, &clearance, &params.seq)?;
-    let (poses, totals) = assemble(&passes, &sequenced, params.home, params.travel_speed, gun.standoff);
+    let (poses, totals) = assemble(&passes, &sequenced, params.home, params.travel_speed);
     let t_seq = t2.elapsed().as_secs_f64();
     Ok(SprayPlan {
         partition,
@@ -232,6 +228,17 @@ pub fn plan(mesh: &Mesh, params: &SprayParams) -> Result<SprayPlan, SprayError> 
         optimum,
         timings: Timings { partition_s: t_part, passes_s: t_passes, sequence_s: t_seq },
     })
+}
+
+/// Patches of less than R² (R the spray radius) with a neighbour that is not that small get no
+/// passes of their own: they are slivers left by the region growing (a corner of a rim, a
+/// fillet), and their neighbours' passes run over them as over a free edge.
+fn absorbed(part: &Partition, radius: f64) -> Vec<bool> {
+    let small: Vec<bool> = part.patches.iter().map(|p| p.area < radius * radius).collect();
+    part.patches
+        .iter()
+        .map(|p| small[p.id as usize] && p.neighbors.iter().any(|n| !small[n.patch as usize]))
+        .collect()
 }
 
 fn check_count(n: usize) -> Result<(), SprayError> {

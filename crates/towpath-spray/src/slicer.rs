@@ -168,6 +168,7 @@ pub(crate) fn slices(mesh: &Mesh, m: DVec3, offsets: &[f64], standoff: f64, step
             let geom = Geom {
                 positions: positions.iter().zip(&normals).map(|(p, n)| *p + *n * standoff).collect(),
                 axes: normals.iter().map(|n| -*n).collect(),
+                targets: positions,
                 closed,
             };
             out.push(geom);

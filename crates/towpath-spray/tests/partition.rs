@@ -79,3 +79,63 @@ fn patches_cover_every_triangle_once_with_symmetric_neighbours() {
     }
     assert!(count.iter().all(|&c| c == 1));
 }
+
+/// Number of boundary loops of a face set (mesh boundary or other patches).
+fn loops_of(mesh: &towpath_geom::Mesh, faces: &[u32]) -> usize {
+    let set: std::collections::HashSet<u32> = faces.iter().copied().collect();
+    let mut next: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+    for &f in faces {
+        let t = mesh.triangles()[f as usize];
+        for k in 0..3 {
+            let g = mesh.neighbor(f, k);
+            if g == towpath_geom::NO_FACE || !set.contains(&g) {
+                assert!(next.insert(t[k], t[(k + 1) % 3]).is_none(), "a pinched border");
+            }
+        }
+    }
+    let mut seen = std::collections::HashSet::new();
+    let mut loops = 0;
+    let mut keys: Vec<u32> = next.keys().copied().collect();
+    keys.sort_unstable();
+    for s in keys {
+        if seen.contains(&s) {
+            continue;
+        }
+        loops += 1;
+        let mut v = s;
+        while seen.insert(v) {
+            v = next[&v];
+        }
+    }
+    loops
+}
+
+#[test]
+fn a_plate_with_a_hole_is_split_into_hole_free_cells() {
+    let mesh = plate_with_hole(600.0, 400.0, [200.0, 400.0, 100.0, 300.0], 10.0);
+    assert_eq!(loops_of(&mesh, &(0..mesh.num_faces() as u32).collect::<Vec<_>>()), 2);
+    let p = partition(&mesh, &opts(20.0));
+    assert!(p.patches.len() >= 2, "a hole needs at least two cells");
+    assert_eq!(p.cells, p.patches.len(), "flat cells stay whole");
+    let mut count = vec![0; mesh.num_faces()];
+    for q in &p.patches {
+        assert_eq!(loops_of(&mesh, &q.faces), 1, "patch {} has a hole", q.id);
+        for &f in &q.faces {
+            count[f as usize] += 1;
+        }
+    }
+    assert!(count.iter().all(|&c| c == 1));
+    // Without the topology split the plate is one (holed) patch.
+    let one = partition(&mesh, &PartitionOptions { topology: false, ..opts(20.0) });
+    assert_eq!(one.patches.len(), 1);
+}
+
+#[test]
+fn a_notched_plate_is_split_and_a_convex_one_is_not() {
+    // An L shape (a 300 × 300 plate without its 150 × 150 top-right quarter) has a reflex
+    // corner; a rectangle has none.
+    let l = plate_with_hole(300.0, 300.0, [150.0, 301.0, 150.0, 301.0], 10.0);
+    assert_eq!(partition(&l, &opts(20.0)).cells, 2);
+    let r = analytic("plane:a=300,b=200", 500);
+    assert_eq!(partition(&r, &opts(20.0)).cells, 1);
+}

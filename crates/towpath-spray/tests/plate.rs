@@ -111,3 +111,40 @@ fn plate_at_the_optimal_spacing_is_uniform_inside() {
     assert!(map.whole.within_20pct > 0.99, "{:?}", map.whole);
     assert_eq!(map.uncovered_triangles, 0);
 }
+
+#[test]
+fn a_hole_splits_the_passes_crossing_it() {
+    // 600 × 400 plate, hole [200, 400] × [100, 300], one patch (no topology split), passes
+    // along x every 20 mm. A line crossing the hole farther than the run-out (50 mm) from the
+    // hole's top and bottom edges is split in two, each part running 50 mm into the hole; a
+    // line nearer those edges runs across (it sprays the edge from inside the hole).
+    let mesh = plate_with_hole(600.0, 400.0, [200.0, 400.0, 100.0, 300.0], 10.0);
+    let mut p = params(20.0);
+    p.topology = false;
+    p.pattern = towpath_spray::PatternChoice::Zigzag;
+    let d = 20.0;
+    p.spacing = Some(d);
+    let plan = plan(&mesh, &p).unwrap();
+    assert_eq!(plan.partition.patches.len(), 1);
+    let e = p.gun.radius;
+    let mut by_line: std::collections::BTreeMap<i64, Vec<(f64, f64)>> = Default::default();
+    for ps in &plan.passes {
+        let y = ps.positions[0].y;
+        let xs = ps.positions.iter().map(|q| q.x);
+        let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+        by_line.entry((y * 1000.0).round() as i64).or_default().push((lo, hi));
+    }
+    let mut split = 0;
+    for (ykey, mut ivs) in by_line {
+        let y = ykey as f64 / 1000.0;
+        ivs.sort_by(|a, b| a.0.total_cmp(&b.0));
+        if y > 100.0 + e && y < 300.0 - e {
+            split += 1;
+            assert_eq!(ivs.len(), 2, "line y = {y}: {ivs:?}");
+            assert!((ivs[0].1 - (200.0 + e)).abs() < 1e-6 && (ivs[1].0 - (400.0 - e)).abs() < 1e-6, "{ivs:?}");
+        } else {
+            assert_eq!(ivs.len(), 1, "line y = {y}: {ivs:?}");
+        }
+    }
+    assert_eq!(split, 4, "lines y = (k + ½) 20 = 170, 190, 210, 230");
+}
