@@ -360,7 +360,8 @@ impl<'m> Frame<'m> {
                 let nx = self.links[i].1;
                 if nx != usize::MAX && self.border[nx].ext > 0.0 {
                     let f = &self.border[nx];
-                    if let Some(iv) = wedge_interval(e.b, e.ext.max(f.ext), e.b - e.a, f.b - f.a, dir, c).and_then(clip) {
+                    if let Some(iv) = wedge_interval(e.b, e.ext.max(f.ext), e.b - e.a, f.b - f.a, dir, c).and_then(clip)
+                    {
                         ivs.push(iv);
                     }
                 }

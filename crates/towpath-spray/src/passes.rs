@@ -32,7 +32,7 @@ use serde::Serialize;
 
 use crate::deposition::Gun;
 use crate::frame::Frame;
-use crate::spacing::{self, SpacingChoice};
+use crate::spacing::{self, Side, SpacingChoice};
 
 /// Time a pass end (stop, turn, restart) costs in the pattern choice of `auto` (s).
 pub const TURN_SECONDS: f64 = 0.3;
@@ -248,45 +248,40 @@ impl Lines {
     }
 }
 
-fn lines_for(frame: &Frame, dir: DVec2, params: &PassParams) -> Lines {
+/// The zigzag lines of a direction. With `optimise`, an unset spacing is searched for this
+/// patch ([`spacing::zigzag_layout`]); without, the profile's optimum is used (fitted to a whole
+/// number of passes between two seams), which is enough to compare directions.
+fn lines_for(frame: &Frame, dir: DVec2, params: &PassParams, optimise: bool) -> Lines {
     let m = dir.perp();
     let (lo, hi) = frame.extent(m);
     let g = &params.gun;
-    let d0 = params.spacing.unwrap_or(params.optimum.spacing);
+    let d0 = params.optimum.spacing;
     let e = frame.max_ext();
     // Spacing is measured on the surface: along the line across the passes through the
     // centroid, offsets map to arc length.
     let arc = ArcMap::new(frame, m, dir.dot(frame.centroid) * dir, lo - e - 2.0 * d0, hi + e + 2.0 * d0);
     let (slo, shi) = (arc.s(lo), arc.s(hi));
     let width = shi - slo;
-    let (seam_lo, seam_hi) = (seam_side(frame, m, lo, d0), seam_side(frame, m, hi, d0));
-    // The lattice starts half a spacing inside a seam side, so that the neighbour's lattice
-    // continues it; with seams on both sides an optimised spacing is fitted to the width.
-    let (d, anchor) = match (params.spacing, seam_lo, seam_hi) {
-        (None, true, true) => (spacing::fit(&g.profile, g.radius, width, d0).1, slo),
-        (_, false, true) => {
-            let n = (width / d0).floor();
-            (d0, shi - n * d0 - d0)
-        }
-        _ => (d0, slo),
+    let side = |seam: bool| if seam { Side::Seam } else { Side::Free };
+    let sides = (side(seam_side(frame, m, lo, d0)), side(seam_side(frame, m, hi, d0)));
+    let fixed = match (params.spacing, optimise) {
+        (Some(d), _) => Some(d),
+        (None, true) => None,
+        (None, false) if sides == (Side::Seam, Side::Seam) => Some(spacing::fit(&g.profile, g.radius, width, d0).1),
+        (None, false) => Some(d0),
     };
-    let kmin = ((slo - e - anchor) / d - 0.5).floor() as i64;
-    let kmax = ((shi + e - anchor) / d - 0.5).ceil() as i64;
+    let layout = spacing::zigzag_layout(&g.profile, g.radius, width, sides, e, d0, fixed);
     let min_len = 1e-3 * g.radius;
     let mut lines = Vec::new();
-    for k in kmin..=kmax {
-        let cs = anchor + (k as f64 + 0.5) * d;
-        if !(cs > slo - e - 1e-9 && cs < shi + e + 1e-9) {
-            continue;
-        }
-        let c = arc.x(cs);
+    for &x in &layout.passes {
+        let c = arc.x(slo + x);
         let ivs: Vec<(f64, f64)> =
             frame.line_intervals(dir, c).into_iter().filter(|iv| iv.1 - iv.0 > min_len).collect();
         if !ivs.is_empty() {
             lines.push((c, ivs));
         }
     }
-    Lines { dir, spacing: d, lines }
+    Lines { dir, spacing: layout.spacing, lines }
 }
 
 /// Arc length on the surface along a line of the projection plane, as a function of the
@@ -419,7 +414,7 @@ pub(crate) fn simplify_closed(pts: &[DVec2], tol: f64) -> Vec<DVec2> {
 pub(crate) fn zigzag(frame: &Frame, params: &PassParams) -> Option<Planned> {
     let mut best: Option<Lines> = None;
     for dir in directions(frame, params.gun.radius) {
-        let l = lines_for(frame, dir, params);
+        let l = lines_for(frame, dir, params, false);
         let better = match &best {
             None => true,
             Some(b) => l.count() < b.count() || (l.count() == b.count() && l.length() < b.length() - 1e-9),
@@ -428,7 +423,13 @@ pub(crate) fn zigzag(frame: &Frame, params: &PassParams) -> Option<Planned> {
             best = Some(l);
         }
     }
-    let lines = best?;
+    let mut lines = best?;
+    if params.spacing.is_none() {
+        let tuned = lines_for(frame, lines.dir, params, true);
+        if tuned.count() > 0 {
+            lines = tuned;
+        }
+    }
     let h = params.gun.standoff;
     let step = params.step();
     let m = lines.dir.perp();
@@ -489,7 +490,7 @@ pub(crate) fn spiral(frame: &Frame, params: &PassParams) -> Option<Planned> {
     }
     let d = match params.spacing {
         Some(d) => d,
-        None => spacing::fit(&params.gun.profile, params.gun.radius, inner_max, d0).1,
+        None => spacing::spiral_spacing(&params.gun.profile, params.gun.radius, inner_max, e, d0).0,
     };
     let mut levels = Vec::new();
     let mut k = 0;

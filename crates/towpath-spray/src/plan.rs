@@ -235,10 +235,7 @@ pub fn plan(mesh: &Mesh, params: &SprayParams) -> Result<SprayPlan, SprayError> 
 /// fillet), and their neighbours' passes run over them as over a free edge.
 fn absorbed(part: &Partition, radius: f64) -> Vec<bool> {
     let small: Vec<bool> = part.patches.iter().map(|p| p.area < radius * radius).collect();
-    part.patches
-        .iter()
-        .map(|p| small[p.id as usize] && p.neighbors.iter().any(|n| !small[n.patch as usize]))
-        .collect()
+    part.patches.iter().map(|p| small[p.id as usize] && p.neighbors.iter().any(|n| !small[n.patch as usize])).collect()
 }
 
 fn check_count(n: usize) -> Result<(), SprayError> {

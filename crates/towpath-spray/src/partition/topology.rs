@@ -114,11 +114,8 @@ fn shape(mesh: &Mesh, faces: &[u32], plane: &Plane, tol: f64) -> Shape {
     let set: HashSet<u32> = faces.iter().copied().collect();
     let loops = outline(mesh, faces, &set, plane);
     let simp: Vec<Vec<DVec2>> = loops.iter().map(|l| simplify_closed(l, tol)).collect();
-    let outer = simp
-        .iter()
-        .max_by(|a, b| signed_area(a).abs().total_cmp(&signed_area(b).abs()))
-        .cloned()
-        .unwrap_or_default();
+    let outer =
+        simp.iter().max_by(|a, b| signed_area(a).abs().total_cmp(&signed_area(b).abs())).cloned().unwrap_or_default();
     let (mut reflex, mut sharp) = (0, 0);
     for l in &simp {
         let n = l.len();
@@ -148,7 +145,8 @@ fn shape(mesh: &Mesh, faces: &[u32], plane: &Plane, tol: f64) -> Shape {
             continue;
         }
         let m = e.perp().normalize();
-        let (lo, hi) = outer.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p.dot(m)), h.max(p.dot(m))));
+        let (lo, hi) =
+            outer.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p.dot(m)), h.max(p.dot(m))));
         width = width.min(hi - lo);
     }
     if !width.is_finite() {
@@ -214,7 +212,15 @@ fn segments_cross(p: DVec2, q: DVec2, a: DVec2, b: DVec2) -> bool {
 
 /// The interval (of those given) nearest to parameter `s`.
 fn nearest_interval(ivs: &[(f64, f64)], s: f64) -> Option<(f64, f64)> {
-    let gap = |iv: &(f64, f64)| if s < iv.0 { iv.0 - s } else if s > iv.1 { s - iv.1 } else { 0.0 };
+    let gap = |iv: &(f64, f64)| {
+        if s < iv.0 {
+            iv.0 - s
+        } else if s > iv.1 {
+            s - iv.1
+        } else {
+            0.0
+        }
+    };
     ivs.iter().copied().min_by(|a, b| gap(a).total_cmp(&gap(b)))
 }
 
@@ -259,7 +265,11 @@ fn cuts(frame: &Frame, loops: &[Vec<DVec2>], t: DVec2, tol: f64) -> Vec<Cut> {
                 k = (k + 1) % n;
             }
             let xs = run.iter().map(|&k| lp[k].dot(m));
-            let xc = if is_min { xs.fold(f64::INFINITY, f64::min) - eps } else { xs.fold(f64::NEG_INFINITY, f64::max) + eps };
+            let xc = if is_min {
+                xs.fold(f64::INFINITY, f64::min) - eps
+            } else {
+                xs.fold(f64::NEG_INFINITY, f64::max) + eps
+            };
             let mid = run.iter().map(|&k| lp[k].dot(t)).sum::<f64>() / run.len() as f64;
             if let Some((s0, s1)) = nearest_interval(&frame.line_intervals(t, xc), mid) {
                 out.push(Cut { a: m * xc + t * s0, b: m * xc + t * s1 });
