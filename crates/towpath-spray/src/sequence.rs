@@ -33,6 +33,9 @@ pub const MAX_ROUNDS: usize = 6;
 pub const KICKS_PER_PASS: u64 = 100;
 /// Smallest default work budget.
 pub const MIN_KICKS: u64 = 2000;
+/// Up to this many pairs of pass ends on different patches, every such transit is priced as
+/// written before the first solve (in parallel), so the solver sees the lifts from the start.
+pub const EAGER_PAIRS: usize = 20_000;
 
 /// How to sequence.
 #[derive(Debug, Clone)]
@@ -177,10 +180,39 @@ pub fn sequence(
     };
     let spray_len: f64 = passes.iter().map(|p| p.length).sum();
     let mut known = Known::default();
+    let mut transit_cache: HashMap<(u32, u32), Transit> = HashMap::new();
+    // Small plans: price every transit between ends on different patches now (within a patch
+    // the moves are short and almost always straight; the lazy rounds catch the rest).
+    let ends = 2 * n as u32;
+    let cross = |a: u32, b: u32| passes[(a / 2) as usize].patch != passes[(b / 2) as usize].patch;
+    let count: usize = {
+        let mut per_patch: HashMap<u32, usize> = HashMap::new();
+        for p in passes {
+            *per_patch.entry(p.patch).or_insert(0) += 2;
+        }
+        let same: usize = per_patch.values().map(|c| c * c).sum();
+        ((2 * n) * (2 * n) - same) / 2
+    };
+    if count <= EAGER_PAIRS {
+        let pairs: Vec<(u32, u32)> =
+            (0..ends).flat_map(|a| (a + 1..ends).filter(move |&b| cross(a, b)).map(move |b| (a, b))).collect();
+        let priced: Vec<((u32, u32), Transit)> = pairs
+            .par_iter()
+            .map(|&(a, b)| {
+                let (pa, pb) = (positions[a as usize], positions[b as usize]);
+                ((a, b), clearance.transit(pa, normal_of(a), pb, normal_of(b)))
+            })
+            .collect();
+        for ((a, b), t) in priced {
+            let straight = positions[a as usize].distance(positions[b as usize]);
+            if t.length > straight * (1.0 + 1e-12) + 1e-9 {
+                known.insert(key(a, b), t.length);
+            }
+        }
+    }
     let mut initial: Option<Vec<Step>> = None;
     let mut rounds = 0;
     let mut solver_seconds = 0.0;
-    let mut transit_cache: HashMap<(u32, u32), Transit> = HashMap::new();
     let steps = loop {
         rounds += 1;
         let cost = TransitCost { positions: positions.clone(), known: known.clone() };

@@ -139,3 +139,32 @@ fn a_notched_plate_is_split_and_a_convex_one_is_not() {
     let r = analytic("plane:a=300,b=200", 500);
     assert_eq!(partition(&r, &opts(20.0)).cells, 1);
 }
+
+#[test]
+fn a_closed_tube_is_split_not_refused() {
+    // A full tube: its normals cancel out, so it is not projectable; it is split by normal
+    // direction first. Around the ring, columns of facets can be grouped k to a patch, so the
+    // count is ⌈columns / k⌉ or one more where the last group wraps round to the first.
+    let mesh = analytic("cylinder:r=300,l=500", 20000);
+    let mut angles: Vec<f64> = (0..mesh.num_faces() as u32)
+        .map(|f| {
+            let n = mesh.face_normal(f);
+            n.y.atan2(n.x).to_degrees()
+        })
+        .collect();
+    angles.sort_by(f64::total_cmp);
+    angles.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
+    let columns = angles.len();
+    let w = 360.0 / columns as f64;
+    let beta = 25.0;
+    let p = partition(&mesh, &opts(beta));
+    assert_eq!(p.pieces, 1);
+    assert_eq!(p.presplit_pieces, 1, "a tube is not projectable");
+    let k = (2.0 * beta / w).floor() as usize + 1;
+    let n = p.patches.len();
+    assert!(n == columns.div_ceil(k) || n == columns.div_ceil(k) + 1, "{n} patches, {columns} columns, {k} per patch");
+    for q in &p.patches {
+        assert!(q.mda_deg <= beta + 1e-9);
+        assert_eq!(loops_of(&mesh, &q.faces), 1, "patch {} is not a simple strip", q.id);
+    }
+}
