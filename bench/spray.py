@@ -290,6 +290,25 @@ def flow_target(opts, target):
     return ["--target-thickness", str(target), *opts, "--threads", "2"]
 
 
+def sensitivity():
+    """Sphere cap: thickness (re-simulated) by beta_th and pattern."""
+    os.makedirs(OUT, exist_ok=True)
+    rows = ["| β_th | pattern | patches | passes | patterns | RMS (interior) | within ±20 % (interior) | cycle s |",
+            "|---|---|---|---|---|---|---|---|"]
+    for beta in ("15", "20", "30", "45"):
+        for pat in ("auto", "zigzag"):
+            opts = ["--standoff", "200", "--spray-radius", "50", "--max-deviation", beta, "--pattern", pat]
+            r = run_towpath("sens", "sphere:r=400,lat0=30,lat1=90", flow_target(opts, 20.0), f"{beta}_{pat}", 1)
+            ev = evaluate(r, 20.0)
+            s = r["summary"]
+            pats = ", ".join(f"{k} {v}" for k, v in sorted(s["patterns"].items()))
+            rows.append(f"| {beta}° | {pat} | {s['patches']} | {s['passes']} | {pats} | {100 * ev['rms_rel']:.2f} % | "
+                        f"{100 * ev['within20_interior']:.2f} % | {ev['cycle']:.1f} |")
+            print(rows[-1], flush=True)
+    with open(os.path.join(OUT, "sensitivity.md"), "w") as fh:
+        fh.write("\n".join(rows) + "\n")
+
+
 def fmt(x, nd=2):
     return "—" if x is None else f"{x:.{nd}f}"
 
@@ -300,7 +319,12 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--no-write", action="store_true")
     ap.add_argument("--only", default=None)
+    ap.add_argument("--sensitivity", action="store_true",
+                    help="only the sphere-cap study of beta_th x pattern, to bench/out/spray/sensitivity.md")
     args = ap.parse_args()
+    if args.sensitivity:
+        sensitivity()
+        return
     if not os.path.exists(BIN):
         subprocess.check_call(["cargo", "build", "--release", "-p", "towpath"], cwd=ROOT)
     os.makedirs(OUT, exist_ok=True)

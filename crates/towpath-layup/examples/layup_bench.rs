@@ -67,7 +67,12 @@ fn main() {
                     let start = Located::new(&mesh, mesh.closest_point(p0).expect("start"));
                     let rosette = Rosette { axis: DVec3::Z, angle: 45f64.to_radians() };
                     let steer = if field_course { Steering::Field(&rosette) } else { Steering::Geodesic };
-                    let opts = WalkOptions { max_length: 500.0, midpoint: smooth, smooth_normals: smooth };
+                    let opts = WalkOptions {
+                        max_length: 500.0,
+                        midpoint: smooth,
+                        smooth_normals: smooth,
+                        ..WalkOptions::default()
+                    };
                     let path = trace_both(&mesh, start, d0, steer, &opts, |_| false).expect("trace");
                     let secs = t0.elapsed().as_secs_f64();
                     let reference = Reference::new(s, start.p, path.points[path.start_index].d).expect("reference");

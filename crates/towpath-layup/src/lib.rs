@@ -10,6 +10,9 @@
 //!   against the courses already laid ([`laid`]).
 //! - [`accuracy`]: deviations from closed-form geodesics on analytic surfaces (seed 001 §4).
 //! - [`output`]: courses as JSON, CSV and a G-code program.
+//! - [`request`]: a whole job as one call — [`request::LayupRequest`] (what the command line
+//!   and a server fill in), validated in one place, its work bounded before it starts, run by
+//!   [`request::run`] to a [`request::LayupResult`] with warnings; [`units`]: input units.
 
 // `!(a > b)` is used on purpose: it is also true when a or b is NaN, which input checks rely on.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -23,5 +26,7 @@ pub mod laid;
 pub mod output;
 pub mod ply;
 pub mod quality;
+pub mod request;
 pub mod section;
 pub mod trace;
+pub mod units;

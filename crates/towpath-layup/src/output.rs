@@ -31,6 +31,8 @@ pub struct Meta {
     pub method: Method,
     /// Ply number in programs.
     pub ply_number: usize,
+    /// Units the surface and lengths were given in (every output is in millimetres).
+    pub input_units: crate::units::Units,
 }
 
 #[derive(Serialize)]
@@ -73,6 +75,7 @@ struct Summary<'a> {
     n1: usize,
     n2: usize,
     n_estimate: [usize; 2],
+    section_width: f64,
     seconds: f64,
     timings: crate::ply::Timings,
     #[serde(flatten)]
@@ -109,6 +112,7 @@ pub fn summary(ply: &Ply) -> serde_json::Value {
         n1: ply.n1,
         n2: ply.n2,
         n_estimate: ply.n_estimate,
+        section_width: ply.section_width,
         seconds: ply.seconds,
         timings: ply.timings,
         quality: quality_summary(&ply.quality),

@@ -51,10 +51,12 @@ pub struct PlySpec {
     /// Start point of the reference course (projected onto the mesh); `None`: the point of the ply
     /// nearest its centroid.
     pub start: Option<DVec3>,
-    /// Upper bound on the number of courses.
+    /// Most courses to lay: a ply that needs more is refused ([`PlyError::TooManyCourses`]).
     pub max_courses: usize,
     /// Spacing of trimming stations along a course (mm).
     pub station_step: f64,
+    /// Stop with [`PlyError::TimeLimit`] after this instant.
+    pub deadline: Option<Instant>,
 }
 
 impl PlySpec {
@@ -70,6 +72,7 @@ impl PlySpec {
             start: None,
             max_courses: 10_000,
             station_step: tow_width.min(5.0),
+            deadline: None,
         }
     }
     fn band(&self) -> Band {
@@ -89,6 +92,12 @@ pub struct Ply {
     /// Seed 002 eq. 9 estimate ⌈max section length / course width⌉ on each side (left, right),
     /// from sections across the reference course.
     pub n_estimate: [usize; 2],
+    /// The ply's width across the fibers at the reference course (mm): the longest section on
+    /// the left plus the longest on the right.
+    pub section_width: f64,
+    /// Whether the surface closed on itself across the fibers (a ply round a tube): the
+    /// sections on both sides then run round the same surface.
+    pub wraps: bool,
     /// Quality figures.
     pub quality: PlyQuality,
     /// Time spent planning (s).
@@ -123,6 +132,15 @@ pub enum PlyError {
     /// Nothing to start from.
     #[error("the mesh is empty")]
     Empty,
+    /// Covering the ply would take more courses than the limit.
+    #[error("the ply needs more than {0} courses; use wider tows or more tows per course, or a smaller ply")]
+    TooManyCourses(usize),
+    /// The deadline passed before the ply was planned.
+    #[error("the time limit was reached while planning the ply ({courses} courses traced); nothing was written")]
+    TimeLimit {
+        /// Courses traced (or trimmed) by then.
+        courses: usize,
+    },
 }
 
 /// The outcome of looking for the next course on one side.
@@ -151,6 +169,11 @@ struct Planner<'a> {
 }
 
 /// Plans a ply: reference course, offsets on both sides, trimming, quality.
+///
+/// Refused when the band is not a band, the mesh is empty, the start is outside the ply or has
+/// no design direction; stopped with [`PlyError::TooManyCourses`] when covering the ply would
+/// take more than `spec.max_courses` courses and with [`PlyError::TimeLimit`] at
+/// `spec.deadline` (never a partial ply presented as a whole one).
 pub fn plan(
     mesh: &Mesh,
     field: &dyn DirectionField,
@@ -170,132 +193,50 @@ pub fn plan(
     let (lo, hi) = mesh.bounds();
     let diag = (hi - lo).length();
     let mut pl = Planner { mesh, field, region, spec, grid: Default::default(), max_len: 3.0 * diag };
-    let start_pt = spec.start.unwrap_or_else(|| default_start(mesh, region));
-    let sp = mesh.closest_point(start_pt).ok_or(PlyError::Empty)?;
-    let start = Located::new(mesh, sp);
-    if region.has_curve() && region.curve_distance(start.p, start.n) < 0.0 {
-        return Err(PlyError::StartOutside(start.p.to_array()));
-    }
-    let d0 = field.direction(start.p, start.n).ok_or(PlyError::NoDirection(start.p.to_array()))?;
-    let method_steer = match spec.method {
-        Method::Field => Steering::Field(field),
-        Method::Parallel | Method::Natural => Steering::Geodesic,
-    };
-    let reference = pl.trace(start, d0, method_steer);
-    pl.remember(&reference, 0);
-    let mut done = 1usize;
-    progress(done);
-    let n_estimate = pl.estimate(&reference);
-    let mut sides: [Vec<Vec<PathPoint>>; 2] = [Vec::new(), Vec::new()];
-    // Whether a side stopped because its next course would land on a course laid more than two
-    // courses away from it: the surface closes on itself across the fibers (a helical ply on a
-    // tube).
-    let mut blocked = false;
-    for (si, sign) in [(0usize, 1.0f64), (1, -1.0)] {
-        let mut prev = reference.clone();
-        let mut prev_index = 0i32;
-        while done < spec.max_courses {
-            let next = pl.next_course(&prev, prev_index, sign, method_steer, false);
-            let next = match next {
-                Next::Course(c) => c,
-                Next::Blocked => {
-                    blocked = true;
-                    break;
-                }
-                Next::End => break,
-            };
-            prev_index += sign as i32;
-            pl.remember(&next, prev_index);
-            done += 1;
-            progress(done);
-            sides[si].push(next.clone());
-            prev = next;
-        }
-    }
-    // On a closed surface the courses leave a strip narrower than a course where the last course
-    // meets the first. One closing course is laid over it, right of the rightmost course (else
-    // left of the leftmost), with its tows trimmed against the courses already laid under the
-    // coverage rule, as at the ply boundary.
-    let mut closing: Option<(i8, Vec<PathPoint>)> = None;
-    if blocked && done < spec.max_courses {
-        for (si, sign) in [(1usize, -1.0f64), (0, 1.0)] {
-            let prev = sides[si].last().unwrap_or(&reference);
-            let prev_index = sign as i32 * sides[si].len() as i32;
-            if let Next::Course(c) = pl.next_course(prev, prev_index, sign, method_steer, true) {
-                closing = Some((sign as i8, c));
-                break;
-            }
-        }
-    }
-    let [left, right] = sides;
-    let (mut n1, mut n2) = (left.len(), right.len());
-    // Lateral order: rightmost first.
-    let mut lines: Vec<(i8, usize, Vec<PathPoint>)> = Vec::new();
-    for (i, c) in right.into_iter().enumerate().rev() {
-        lines.push((-1, i + 1, c));
-    }
-    lines.push((0, 0, reference));
-    for (i, c) in left.into_iter().enumerate() {
-        lines.push((1, i + 1, c));
-    }
+    let traced = pl.centrelines(progress)?;
     timings.courses = tp.elapsed().as_secs_f64();
     let tp = Instant::now();
-    let sectioner = Sectioner { mesh, region, band: spec.band(), occupied: None };
-    // Courses are trimmed independently (in parallel; the result does not depend on threads).
-    let prepared: Vec<(i8, usize, Vec<PathPoint>, Vec<bool>)> = lines
-        .into_iter()
-        .map(|(side, offset_index, pts)| {
-            let (pts, on) = pl.run_out(pts);
-            (side, offset_index, pts, on)
-        })
-        .collect();
-    // `shortest`: laid pieces shorter than this are dropped.
-    let trim = |sectioner: &Sectioner<'_>,
-                (side, offset_index, pts, on_surface): (i8, usize, Vec<PathPoint>, Vec<bool>),
-                shortest: f64| {
-        let mut tows = sectioner.trim(&pts, spec.coverage, spec.station_step, 1e-3);
-        for ivs in &mut tows {
-            ivs.retain(|iv| iv[1] - iv[0] >= shortest);
-        }
-        let mut c = Course { id: 0, side, offset_index, points: pts, on_surface, tows };
-        crop(&mut c);
-        c
-    };
-    let mut courses: Vec<Course> = prepared.into_par_iter().map(|x| trim(&sectioner, x, 0.0)).collect();
-    if let Some((side, pts)) = closing {
-        // Lines over laid tows (by more than a twentieth of a tow, 0.32 mm for 6.35 mm tows, so
-        // that abutting edges are free despite the tangent-plane offsets of [`LaidMap`]) count as
-        // outside the ply for the closing course.
-        let laid = LaidMap::new(&courses, spec.band());
-        let inset = 0.05 * spec.tow_width;
-        let occupied = |q: DVec3| laid.covers(q, inset);
-        let closing_sectioner = Sectioner { mesh, region, band: spec.band(), occupied: Some(&occupied) };
-        let offset_index = if side < 0 { n2 + 1 } else { n1 + 1 };
-        let (pts, on) = pl.run_out(pts);
-        // The closing course fills the strip along its length; the slivers of free surface it
-        // also finds where other courses end at the boundary are not worth a tow restart: pieces
-        // shorter than one course width are dropped.
-        let c = trim(&closing_sectioner, (side, offset_index, pts, on), pl.width());
-        if c.laid_range().is_some() {
-            if side < 0 {
-                n2 += 1;
-                courses.insert(0, c);
-            } else {
-                n1 += 1;
-                courses.push(c);
-            }
-        }
-    }
-    courses.retain(|c| c.laid_range().is_some());
-    for (i, c) in courses.iter_mut().enumerate() {
-        c.id = i;
-    }
+    let (courses, n1, n2) = pl.trim_all(traced.lines, traced.closing, traced.n1, traced.n2)?;
     timings.trim = tp.elapsed().as_secs_f64();
     let tp = Instant::now();
     let quality = quality::assess(mesh, field, region, spec, &courses);
+    check_time(spec, courses.len())?;
     timings.quality = tp.elapsed().as_secs_f64();
-    Ok(Ply { courses, n1, n2, n_estimate, quality, seconds: t0.elapsed().as_secs_f64(), timings })
+    Ok(Ply {
+        courses,
+        n1,
+        n2,
+        n_estimate: traced.n_estimate,
+        section_width: traced.section_width,
+        wraps: traced.wraps,
+        quality,
+        seconds: t0.elapsed().as_secs_f64(),
+        timings,
+    })
 }
+
+/// Fails with [`PlyError::TimeLimit`] once the spec's deadline has passed.
+fn check_time(spec: &PlySpec, courses: usize) -> Result<(), PlyError> {
+    match spec.deadline {
+        Some(d) if Instant::now() >= d => Err(PlyError::TimeLimit { courses }),
+        _ => Ok(()),
+    }
+}
+
+/// Centrelines of a ply before trimming, in lateral order (rightmost first): (side, rank on the
+/// side, points); the closing course of a closed surface apart.
+struct Traced {
+    lines: Vec<(i8, usize, Vec<PathPoint>)>,
+    closing: Option<(i8, Vec<PathPoint>)>,
+    n1: usize,
+    n2: usize,
+    n_estimate: [usize; 2],
+    section_width: f64,
+    wraps: bool,
+}
+
+/// A centreline before trimming: (side, rank on the side, points, whether each is on the mesh).
+type Line = (i8, usize, Vec<PathPoint>, Vec<bool>);
 
 /// The mesh (or ply) point nearest the area centroid.
 fn default_start(mesh: &Mesh, region: &Region) -> DVec3 {
@@ -315,8 +256,165 @@ fn default_start(mesh: &Mesh, region: &Region) -> DVec3 {
 }
 
 impl Planner<'_> {
+    /// The reference course through the start, then offsets on both sides until the ply is
+    /// covered (or the surface closes on itself: then the closing course).
+    fn centrelines(&mut self, progress: Progress<'_>) -> Result<Traced, PlyError> {
+        let (mesh, region, spec, field) = (self.mesh, self.region, self.spec, self.field);
+        let start_pt = spec.start.unwrap_or_else(|| default_start(mesh, region));
+        let sp = mesh.closest_point(start_pt).ok_or(PlyError::Empty)?;
+        let start = Located::new(mesh, sp);
+        if region.has_curve() && region.curve_distance(start.p, start.n) < 0.0 {
+            return Err(PlyError::StartOutside(start.p.to_array()));
+        }
+        let d0 = field.direction(start.p, start.n).ok_or(PlyError::NoDirection(start.p.to_array()))?;
+        let steer = match spec.method {
+            Method::Field => Steering::Field(field),
+            Method::Parallel | Method::Natural => Steering::Geodesic,
+        };
+        let reference = self.trace(start, d0, steer);
+        self.remember(&reference, 0);
+        let mut done = 1usize;
+        progress(done);
+        let (n_estimate, section_width) = self.estimate(&reference);
+        let mut sides: [Vec<Vec<PathPoint>>; 2] = [Vec::new(), Vec::new()];
+        // Whether a side stopped because its next course would land on a course laid more than
+        // two courses away from it: the surface closes on itself across the fibers (a helical
+        // ply on a tube).
+        let mut blocked = false;
+        for (si, sign) in [(0usize, 1.0f64), (1, -1.0)] {
+            let mut prev = reference.clone();
+            let mut prev_index = 0i32;
+            loop {
+                check_time(spec, done)?;
+                let next = match self.next_course(&prev, prev_index, sign, steer, false) {
+                    Next::Course(c) => c,
+                    Next::Blocked => {
+                        blocked = true;
+                        break;
+                    }
+                    Next::End => break,
+                };
+                if done >= spec.max_courses {
+                    return Err(PlyError::TooManyCourses(spec.max_courses));
+                }
+                prev_index += sign as i32;
+                self.remember(&next, prev_index);
+                done += 1;
+                progress(done);
+                sides[si].push(next.clone());
+                prev = next;
+            }
+        }
+        // On a closed surface the courses leave a strip narrower than a course where the last
+        // course meets the first. One closing course is laid over it, right of the rightmost
+        // course (else left of the leftmost), with its tows trimmed against the courses already
+        // laid under the coverage rule, as at the ply boundary.
+        let mut closing: Option<(i8, Vec<PathPoint>)> = None;
+        if blocked {
+            if done >= spec.max_courses {
+                return Err(PlyError::TooManyCourses(spec.max_courses));
+            }
+            for (si, sign) in [(1usize, -1.0f64), (0, 1.0)] {
+                let prev = sides[si].last().unwrap_or(&reference);
+                let prev_index = sign as i32 * sides[si].len() as i32;
+                if let Next::Course(c) = self.next_course(prev, prev_index, sign, steer, true) {
+                    closing = Some((sign as i8, c));
+                    break;
+                }
+            }
+        }
+        let [left, right] = sides;
+        let (n1, n2) = (left.len(), right.len());
+        // Lateral order: rightmost first.
+        let mut lines: Vec<(i8, usize, Vec<PathPoint>)> = Vec::new();
+        for (i, c) in right.into_iter().enumerate().rev() {
+            lines.push((-1, i + 1, c));
+        }
+        lines.push((0, 0, reference));
+        for (i, c) in left.into_iter().enumerate() {
+            lines.push((1, i + 1, c));
+        }
+        Ok(Traced { lines, closing, n1, n2, n_estimate, section_width, wraps: blocked })
+    }
+
+    /// Run-outs, per-tow trimming and cropping of every centreline (independently, in
+    /// parallel; the result does not depend on threads), then the closing course trimmed
+    /// against the courses laid. Returns the courses with laid tows and the updated N₁, N₂.
+    fn trim_all(
+        &self,
+        lines: Vec<(i8, usize, Vec<PathPoint>)>,
+        closing: Option<(i8, Vec<PathPoint>)>,
+        mut n1: usize,
+        mut n2: usize,
+    ) -> Result<(Vec<Course>, usize, usize), PlyError> {
+        let (mesh, region, spec) = (self.mesh, self.region, self.spec);
+        let sectioner = Sectioner { mesh, region, band: spec.band(), occupied: None };
+        let prepared: Vec<Line> = lines
+            .into_iter()
+            .map(|(side, offset_index, pts)| {
+                let (pts, on) = self.run_out(pts);
+                (side, offset_index, pts, on)
+            })
+            .collect();
+        let late = std::sync::atomic::AtomicBool::new(false);
+        let mut courses: Vec<Course> = prepared
+            .into_par_iter()
+            .map(|x| {
+                // Past the deadline the remaining courses are skipped (the run fails below).
+                if late.load(std::sync::atomic::Ordering::Relaxed) || check_time(spec, 0).is_err() {
+                    late.store(true, std::sync::atomic::Ordering::Relaxed);
+                    return Course {
+                        id: 0,
+                        side: x.0,
+                        offset_index: x.1,
+                        points: Vec::new(),
+                        on_surface: Vec::new(),
+                        tows: Vec::new(),
+                    };
+                }
+                trim_line(&sectioner, spec, x, 0.0)
+            })
+            .collect();
+        check_time(spec, courses.len())?;
+        if let Some((side, pts)) = closing {
+            // Lines over laid tows (by more than a twentieth of a tow, 0.32 mm for 6.35 mm tows,
+            // so that abutting edges are free despite the tangent-plane offsets of [`LaidMap`])
+            // count as outside the ply for the closing course.
+            let laid = LaidMap::new(&courses, spec.band());
+            let inset = 0.05 * spec.tow_width;
+            let occupied = |q: DVec3| laid.covers(q, inset);
+            let closing_sectioner = Sectioner { mesh, region, band: spec.band(), occupied: Some(&occupied) };
+            let offset_index = if side < 0 { n2 + 1 } else { n1 + 1 };
+            let (pts, on) = self.run_out(pts);
+            // The closing course fills the strip along its length; the slivers of free surface
+            // it also finds where other courses end at the boundary are not worth a tow restart:
+            // pieces shorter than one course width are dropped.
+            let c = trim_line(&closing_sectioner, spec, (side, offset_index, pts, on), self.width());
+            if c.laid_range().is_some() {
+                if side < 0 {
+                    n2 += 1;
+                    courses.insert(0, c);
+                } else {
+                    n1 += 1;
+                    courses.push(c);
+                }
+            }
+        }
+        courses.retain(|c| c.laid_range().is_some());
+        for (i, c) in courses.iter_mut().enumerate() {
+            c.id = i;
+        }
+        Ok((courses, n1, n2))
+    }
+
     fn width(&self) -> f64 {
         self.spec.tow_width * self.spec.tows as f64
+    }
+
+    /// Walk options of centreline traces: up to the longest course, in steps of at most half a
+    /// course width (triangles larger than that are crossed in several steps).
+    fn course_walk(&self) -> WalkOptions {
+        WalkOptions { max_step: 0.5 * self.width(), ..WalkOptions::up_to(self.max_len) }
     }
 
     fn key(&self, p: DVec3) -> [i64; 3] {
@@ -324,11 +422,23 @@ impl Planner<'_> {
         [f.x.floor() as i64, f.y.floor() as i64, f.z.floor() as i64]
     }
 
+    /// Remembers a course's centreline at points at most a tenth of a course width apart (long
+    /// segments, from large triangles, are filled in).
     fn remember(&mut self, pts: &[PathPoint], lateral: i32) {
+        let gap = 0.1 * self.width();
         let mut last: Option<DVec3> = None;
         for q in pts {
-            if last.is_some_and(|l| l.distance(q.p) < 0.1 * self.width()) {
-                continue;
+            if let Some(l) = last {
+                let d = l.distance(q.p);
+                if d < gap {
+                    continue;
+                }
+                let k = (d / gap).floor() as usize;
+                for j in 1..k {
+                    let x = l.lerp(q.p, j as f64 / k as f64);
+                    let key = self.key(x);
+                    self.grid.entry(key).or_default().push((x, lateral));
+                }
             }
             last = Some(q.p);
             let k = self.key(q.p);
@@ -372,19 +482,21 @@ impl Planner<'_> {
     /// closed once instead of wrapping again.
     fn trace(&self, start: Located, d0: DVec3, steer: Steering<'_>) -> Vec<PathPoint> {
         let w = self.width();
-        let opts = WalkOptions::up_to(self.max_len);
+        let opts = self.course_walk();
         let d_start = match steer {
             Steering::Field(f) => f.direction(start.p, start.n).map(|v| if v.dot(d0) < 0.0 { -v } else { v }),
             Steering::Geodesic => tangent(d0, start.n),
         };
         let Some(d_start) = d_start else { return Vec::new() };
         let mut closed = false;
-        let mut last = start.p;
+        let (mut last, mut last_s) = (start.p, 0.0);
         let (mut fwd, _) = walk(self.mesh, start, d_start, steer, &opts, |q| {
             if self.outside_far(q.p, q.n) {
                 return true;
             }
-            // Back at the start (a hoop): the step from the previous point passes the start.
+            // Back at the start (a hoop): a step from more than a course width along the path
+            // passes the start. (The first step, which leaves the start, does not count, however
+            // long it is: on a coarse mesh it may cross the whole ply.)
             let seg = q.p - last;
             let t = if seg.length_squared() > 0.0 {
                 ((start.p - last).dot(seg) / seg.length_squared()).clamp(0.0, 1.0)
@@ -392,8 +504,9 @@ impl Planner<'_> {
                 0.0
             };
             let near = (last + seg * t).distance(start.p);
-            last = q.p;
-            if q.s > 2.0 * w && near < 0.02 * w {
+            let from = last_s;
+            (last, last_s) = (q.p, q.s);
+            if from > w && q.s > 2.0 * w && near < 0.02 * w {
                 closed = true;
                 return true;
             }
@@ -590,7 +703,7 @@ impl Planner<'_> {
             return Next::Course(all);
         }
         // Extend both ends geodesically until leaving the ply or the mesh.
-        let opts = WalkOptions::up_to(self.max_len);
+        let opts = self.course_walk();
         let ext = |q: &PathPoint, dir: DVec3| -> Vec<PathPoint> {
             let Some(loc) = crate::course::locate(self.mesh, q.p, q.face) else { return Vec::new() };
             walk(self.mesh, loc, dir, Steering::Geodesic, &opts, |x| self.outside_far(x.p, x.n)).0
@@ -660,10 +773,11 @@ impl Planner<'_> {
     }
 
     /// Seed 002 eq. 9: the longest section across the reference course on each side, walked as a
-    /// geodesic perpendicular to the fiber until it leaves the ply, divided by the course width.
-    fn estimate(&self, reference: &[PathPoint]) -> [usize; 2] {
+    /// geodesic perpendicular to the fiber until it leaves the ply, divided by the course width;
+    /// and the two longest sections added (the ply's width across the fibers).
+    fn estimate(&self, reference: &[PathPoint]) -> ([usize; 2], f64) {
         let w = self.width();
-        let Some(len) = reference.last().map(|q| q.s) else { return [0, 0] };
+        let Some(len) = reference.last().map(|q| q.s) else { return ([0, 0], 0.0) };
         let mut best = [0.0f64; 2];
         let count = (len / w).ceil().max(1.0) as usize;
         for i in 0..=count {
@@ -688,8 +802,21 @@ impl Planner<'_> {
         }
         // The reference course covers half a width on each side.
         let count = |l: f64| ((l - 0.5 * w).max(0.0) / w - 1e-6).ceil().max(0.0) as usize;
-        [count(best[0]), count(best[1])]
+        ([count(best[0]), count(best[1])], best[0] + best[1])
     }
+}
+
+/// Trims one centreline per tow under the spec's coverage rule (laid pieces shorter than
+/// `shortest` dropped) and crops it to where tows are laid.
+fn trim_line(sectioner: &Sectioner<'_>, spec: &PlySpec, line: Line, shortest: f64) -> Course {
+    let (side, offset_index, pts, on_surface) = line;
+    let mut tows = sectioner.trim(&pts, spec.coverage, spec.station_step, 1e-3);
+    for ivs in &mut tows {
+        ivs.retain(|iv| iv[1] - iv[0] >= shortest);
+    }
+    let mut c = Course { id: 0, side, offset_index, points: pts, on_surface, tows };
+    crop(&mut c);
+    c
 }
 
 /// Crops a course's centreline to the range where tows are laid (with exact end points).

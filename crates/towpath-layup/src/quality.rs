@@ -76,6 +76,17 @@ pub fn course_figures(c: &Course, field: &dyn DirectionField, spec: &PlySpec) ->
     let h = curvature_window(spec);
     let mut q = CourseQuality::default();
     let (mut j, mut k) = (0usize, 0usize);
+    // Arc-length range of the run of on-surface (or run-out) points containing point i.
+    let on_at = |x: usize| c.on_surface.get(x).copied().unwrap_or(true);
+    let mut runs: Vec<(f64, f64)> = Vec::with_capacity(pts.len());
+    let mut lo = 0;
+    for i in 0..pts.len() {
+        if i + 1 == pts.len() || on_at(i + 1) != on_at(i) {
+            runs.extend(std::iter::repeat_n((pts[lo].s, pts[i].s), i + 1 - lo));
+            lo = i + 1;
+        }
+    }
+    let run_bounds = |i: usize| runs.get(i).copied().unwrap_or((0.0, 0.0));
     for (i, p) in pts.iter().enumerate() {
         let dev = field.direction(p.p, p.n).map_or(0.0, |v| v.dot(p.d).abs().clamp(0.0, 1.0).acos().to_degrees());
         q.angle_deviation_deg.push(dev);
@@ -92,7 +103,20 @@ pub fn course_figures(c: &Course, field: &dyn DirectionField, spec: &PlySpec) ->
         }
         let (a, b) = (&pts[j], &pts[k]);
         let ds = b.s - a.s;
-        let kappa = if ds > 1e-9 { (b.d - a.d).dot(p.n.cross(p.d)) / ds } else { 0.0 };
+        let kappa = if ds >= 0.5 * h {
+            (b.d - a.d).dot(p.n.cross(p.d)) / ds
+        } else {
+            // Points sparser than the window (large triangles crossed in few steps): directions
+            // interpolated at the window's ends, within the same run of on- or off-surface points.
+            let (lo, hi) = run_bounds(i);
+            let (sa, sb) = ((p.s - h).max(lo), (p.s + h).min(hi));
+            if sb - sa > 1e-9 {
+                let (da, db) = (crate::course::frame_at(pts, sa).2, crate::course::frame_at(pts, sb).2);
+                (db - da).dot(p.n.cross(p.d)) / (sb - sa)
+            } else {
+                0.0
+            }
+        };
         q.geodesic_curvature.push(kappa);
         q.steering_radius.push((kappa.abs() > 1e-9).then(|| 1.0 / kappa.abs()));
     }
@@ -186,7 +210,8 @@ fn spacing_to(mesh: &Mesh, c: &Course, near: &Nearest, s: f64, reach: f64) -> Op
     None
 }
 
-/// Assesses a ply.
+/// Assesses a ply: per-point angle and steering figures, gaps and overlaps between neighbours,
+/// coverage of the ply area.
 pub fn assess(
     mesh: &Mesh,
     field: &dyn DirectionField,
@@ -194,9 +219,18 @@ pub fn assess(
     spec: &PlySpec,
     courses: &[Course],
 ) -> PlyQuality {
-    let w = spec.tow_width * spec.tows as f64;
-    let nt = spec.tows;
     let mut pq = PlyQuality { min_steering_radius_limit: spec.min_steering_radius, ..PlyQuality::default() };
+    angles_and_steering(&mut pq, field, spec, courses);
+    gaps_and_overlaps(&mut pq, mesh, spec, courses);
+    let (area, covered) = coverage(mesh, region, spec, courses);
+    pq.ply_area = area;
+    pq.coverage_percent = covered;
+    pq
+}
+
+/// Angle deviation and steering figures of every course (per point and per ply), lengths.
+fn angles_and_steering(pq: &mut PlyQuality, field: &dyn DirectionField, spec: &PlySpec, courses: &[Course]) {
+    let nt = spec.tows;
     let mut angle_sum = 0.0;
     let mut angle_n = 0usize;
     for c in courses {
@@ -225,10 +259,15 @@ pub fn assess(
     if angle_n > 0 {
         pq.mean_angle_deviation_deg = angle_sum / angle_n as f64;
     }
-    // Gaps and overlaps between each course and its left neighbour, where both edge tows are laid:
-    // a geodesic walked from the course's centreline perpendicular to the fiber, to where it
-    // crosses the neighbour's centreline; the spacing minus one course width is the gap (+) or
-    // overlap (−). The last and first courses are tried as a pair too (closed surfaces).
+}
+
+/// Gaps and overlaps between each course and its left neighbour, where both edge tows are laid:
+/// a geodesic walked from the course's centreline perpendicular to the fiber, to where it
+/// crosses the neighbour's centreline; the spacing minus one course width is the gap (+) or
+/// overlap (−). The last and first courses are tried as a pair too (closed surfaces).
+fn gaps_and_overlaps(pq: &mut PlyQuality, mesh: &Mesh, spec: &PlySpec, courses: &[Course]) {
+    let w = spec.tow_width * spec.tows as f64;
+    let nt = spec.tows;
     let step = (0.1 * w).clamp(2.0, 10.0);
     let mut pairs: Vec<(usize, usize)> = (0..courses.len().saturating_sub(1)).map(|i| (i, i + 1)).collect();
     if courses.len() > 2 {
@@ -270,8 +309,11 @@ pub fn assess(
         }
         pq.courses[i].gap_to_left.extend(widths);
     }
-    // Coverage: area-weighted face-centroid samples inside the ply, each checked against the laid
-    // tows of the nearest course stations.
+}
+
+/// Coverage: area-weighted samples inside the ply, each checked against the laid tows of the
+/// nearest course stations. Returns the ply area and the covered share (%).
+fn coverage(mesh: &Mesh, region: &Region, spec: &PlySpec, courses: &[Course]) -> (f64, f64) {
     let laid = LaidMap::new(courses, Band { tow_width: spec.tow_width, tows: spec.tows });
     // Samples: every face split into m × m sub-triangles (m from the face size and a spacing of
     // half a tow width, within a budget), one sample at each sub-triangle's centroid.
@@ -282,7 +324,7 @@ pub fn assess(
         let c = mesh.corners(f);
         c[0].distance(c[1]).max(c[1].distance(c[2])).max(c[2].distance(c[0]))
     };
-    let count_at = |h: f64| (0..nf as u32).map(|f| (edge_max(f) / h).ceil().clamp(1.0, 16.0).powi(2)).sum::<f64>();
+    let count_at = |h: f64| (0..nf as u32).map(|f| (edge_max(f) / h).ceil().clamp(1.0, 64.0).powi(2)).sum::<f64>();
     let mut stride = 1usize;
     while count_at(h) > budget && h < 1e6 {
         h *= 1.5;
@@ -297,7 +339,7 @@ pub fn assess(
         .map(|&f| {
             let c = mesh.corners(f);
             let nf = mesh.face_normal(f);
-            let m = (edge_max(f) / h).ceil().clamp(1.0, 16.0) as usize;
+            let m = (edge_max(f) / h).ceil().clamp(1.0, 64.0) as usize;
             let a = mesh.face_area(f) / (m * m) as f64;
             let (mut area, mut covered) = (0.0, 0.0);
             for i in 0..m {
@@ -328,7 +370,5 @@ pub fn assess(
         area += a;
         covered += c;
     }
-    pq.ply_area = area * stride as f64;
-    pq.coverage_percent = if area > 0.0 { 100.0 * covered / area } else { 0.0 };
-    pq
+    (area * stride as f64, if area > 0.0 { 100.0 * covered / area } else { 0.0 })
 }

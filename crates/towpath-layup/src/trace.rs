@@ -137,11 +137,15 @@ pub struct WalkOptions {
     /// Smooth (interpolated vertex) normals (recommended). Off reproduces seed 001: the face
     /// normal inside a triangle and the area-weighted normal of the two faces on an edge (eq. 12).
     pub smooth_normals: bool,
+    /// Longest step: a triangle longer than this along the path is crossed in several steps, the
+    /// direction evaluated again after each, so a coarse mesh (a plate of two triangles) is
+    /// traced as faithfully as a fine one. `∞`: one step per triangle.
+    pub max_step: f64,
 }
 
 impl Default for WalkOptions {
     fn default() -> Self {
-        WalkOptions { max_length: f64::INFINITY, midpoint: true, smooth_normals: true }
+        WalkOptions { max_length: f64::INFINITY, midpoint: true, smooth_normals: true, max_step: f64::INFINITY }
     }
 }
 
@@ -184,6 +188,9 @@ pub fn walk(
     let mut entry: Option<usize> = None;
     let mut zero_steps = 0u32;
     let max_steps = 4 * mesh.num_faces() + 1000;
+    // Steps inside one triangle (each `max_step` long; bounded by the triangle's size, and here
+    // against a `max_step` too small for it).
+    let mut inner_steps = 0u32;
     let dir_at = |q: DVec3, nq: DVec3, prev: DVec3, nprev: DVec3| -> Option<DVec3> {
         match steering {
             Steering::Geodesic => tangent(transport(prev, nprev, nq), nq),
@@ -200,7 +207,8 @@ pub fn walk(
             None => return (out, Stop::Stuck),
         }
     }
-    for _ in 0..max_steps {
+    let mut crossings = 0usize;
+    while crossings < max_steps {
         let c = mesh.corners(f);
         let nf = mesh.face_normal(f);
         let Some(dface) = tangent(d, nf) else { return (out, Stop::Stuck) };
@@ -210,10 +218,11 @@ pub fn walk(
         let mut n_step = n;
         if opts.midpoint && t > 0.0 {
             // Corrector: the direction at the middle of the predicted step.
-            let bm = b + db * (0.5 * t);
+            let h = t.min(opts.max_step);
+            let bm = b + db * (0.5 * h);
             let sm = SurfacePoint { face: f, bary: bm };
             let nm = if opts.smooth_normals { mesh.smooth_normal(sm) } else { nf };
-            let pm = p + dface * (0.5 * t);
+            let pm = p + dface * (0.5 * h);
             if let Some(dm) = dir_at(pm, nm, d, n) {
                 if let Some(df2) = tangent(dm, nf) {
                     let db2 = bary_rate(&c, df2);
@@ -229,11 +238,15 @@ pub fn walk(
         }
         let remaining = opts.max_length - s;
         let clipped = t >= remaining;
+        // A step that ends inside the triangle (the triangle is longer than the longest step).
+        let inner = !clipped && t > opts.max_step;
         if clipped {
             t = remaining.max(0.0);
+        } else if inner {
+            t = opts.max_step;
         }
         let mut nb = b + db * t;
-        if !clipped {
+        if !clipped && !inner {
             nb[(edge + 2) % 3] = 0.0; // the vertex opposite the exit edge
         }
         let nb = nb.max(DVec3::ZERO);
@@ -242,7 +255,7 @@ pub fn walk(
         let np = mesh.point(sp);
         let nn = if opts.smooth_normals {
             mesh.smooth_normal(sp)
-        } else if clipped {
+        } else if clipped || inner {
             nf
         } else {
             edge_normal(mesh, f, edge)
@@ -268,7 +281,22 @@ pub fn walk(
         if stop(&pt) {
             return (out, Stop::Caller);
         }
+        if inner {
+            // On in the same triangle from the point reached.
+            inner_steps += 1;
+            if inner_steps > 1_000_000 {
+                return (out, Stop::Stuck);
+            }
+            b = nb;
+            p = np;
+            n = nn;
+            d = nd;
+            entry = None;
+            continue;
+        }
         // Cross into the neighbour.
+        crossings += 1;
+        inner_steps = 0;
         let g = mesh.neighbor(f, edge);
         if g == NO_FACE {
             return (out, Stop::Boundary);

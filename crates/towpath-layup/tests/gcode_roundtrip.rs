@@ -45,6 +45,7 @@ fn meta(surface: &str, angle: f64, spec: &PlySpec, ply_number: usize) -> Meta {
         coverage_percent: spec.coverage.percent(),
         method: spec.method,
         ply_number,
+        input_units: towpath_layup::units::Units::Mm,
     }
 }
 

@@ -196,6 +196,7 @@ fn outputs_carry_the_courses_and_tow_events() {
         coverage_percent: 50,
         method: Method::Field,
         ply_number: 3,
+        input_units: towpath_layup::units::Units::Mm,
     };
     let doc = output::to_json(&ply, &meta);
     let courses = doc["courses"].as_array().unwrap();

@@ -124,6 +124,53 @@ impl Kinematics {
     }
 }
 
+/// The tool axis: the direction in which the tool points at the part (the head lies the other
+/// way from the tool point).
+impl Kinematics {
+    /// True when the tool point comes from a DH chain (false: from X/Y/Z linear axes).
+    pub fn has_chain(&self) -> bool {
+        matches!(self.source, Source::Chain { .. })
+    }
+
+    /// The index of the mandrel axis in a state, if the machine has one.
+    pub fn mandrel_index(&self) -> Option<usize> {
+        self.mandrel.map(|(i, _, _)| i)
+    }
+
+    /// The tool axis in the machine frame, a unit vector pointing from the head towards the
+    /// part: with a DH chain the z axis of the last frame; without one (X/Y/Z axes under
+    /// tool-centre-point control) −Z, the head standing above the tool point along +Z.
+    pub fn world_tool_axis(&self, state: &[f64]) -> [f64; 3] {
+        match &self.source {
+            Source::Xyz(_) => [0.0, 0.0, -1.0],
+            Source::Chain { joints, .. } => {
+                let mut r = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+                for j in joints {
+                    let mut theta = j.theta;
+                    if let Some((i, false)) = j.driver {
+                        theta += state.get(i).copied().unwrap_or(0.0).to_radians();
+                    }
+                    let (st, ct) = theta.sin_cos();
+                    let (sa, ca) = j.alpha.sin_cos();
+                    let local_r = [[ct, -st * ca, st * sa], [st, ct * ca, -ct * sa], [0.0, sa, ca]];
+                    r = mat_mul(&r, &local_r);
+                }
+                [r[0][2], r[1][2], r[2][2]]
+            }
+        }
+    }
+
+    /// The tool axis in the part frame ([`Kinematics::world_tool_axis`] turned back by the
+    /// mandrel angle, like [`Kinematics::part_point`]).
+    pub fn part_tool_axis(&self, state: &[f64]) -> [f64; 3] {
+        let u = self.world_tool_axis(state);
+        match self.mandrel {
+            None => u,
+            Some((i, _, k)) => rotate(u, k, -state.get(i).copied().unwrap_or(0.0).to_radians()),
+        }
+    }
+}
+
 fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
@@ -215,6 +262,35 @@ mod tests {
         // After Rx(90°) the tool offset along local z points along world −y.
         assert!(close(k.world_point(&[0.0]), [100.0, -5.0, 10.0]));
         assert!(close(k.world_point(&[7.0]), [100.0, -5.0, 17.0]));
+    }
+
+    /// The tool axis: −Z for X/Y/Z machines (turned with the part frame on a mandrel), the
+    /// last frame's z for a chain (a twist of 90° about x turns it from +z to −y).
+    #[test]
+    fn tool_axis_directions() {
+        let mut mandrel = Axis::new("A", AxisKind::Mandrel);
+        mandrel.direction = Some([1.0, 0.0, 0.0]);
+        let m = Machine::new("cyl", vec![Axis::new("X", AxisKind::Linear), Axis::new("Z", AxisKind::Linear), mandrel])
+            .unwrap();
+        let k = m.kinematics().unwrap();
+        assert!(!k.has_chain());
+        assert_eq!(k.mandrel_index(), Some(2));
+        assert!(close(k.world_tool_axis(&[0.0, 100.0, 90.0]), [0.0, 0.0, -1.0]));
+        // The part turned +90° about +x: in the part frame the tool stands at +y and points
+        // towards −y, at the axis.
+        assert!(close(k.part_tool_axis(&[0.0, 100.0, 90.0]), [0.0, -1.0, 0.0]));
+        let mut s =
+            Machine::new("s", vec![Axis::new("Z", AxisKind::Linear), Axis::new("C", AxisKind::Rotary)]).unwrap();
+        s.dh = vec![
+            DhJoint { a: 0.0, d: 0.0, alpha: 0.0, theta: 0.0, axis: Some("C".into()) },
+            DhJoint { a: 100.0, d: 10.0, alpha: 90.0, theta: 0.0, axis: Some("Z".into()) },
+        ];
+        s.validate().unwrap();
+        let k = s.kinematics().unwrap();
+        assert!(k.has_chain());
+        assert!(close(k.world_tool_axis(&[5.0, 0.0]), [0.0, -1.0, 0.0]));
+        // Turning C by 90° about z turns −y into +x.
+        assert!(close(k.world_tool_axis(&[5.0, 90.0]), [1.0, 0.0, 0.0]));
     }
 
     #[test]

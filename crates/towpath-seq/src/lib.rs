@@ -6,9 +6,12 @@
 //! Transition costs come from a [`CostModel`]: a dense [`MatrixCost`], on-demand [`PointCost`]
 //! distances, or any model another crate provides (machine motion, for instance).
 //!
-//! - [`solve`] runs towpath's solver: construction, local search (Or-opt, 2-opt, mode
-//!   re-selection by exact DP over a layered graph) and iterated local search on several
-//!   threads, within a time or work budget. Deterministic under a work budget.
+//! - [`solve`] runs towpath's solver: construction (nearest neighbour from Doherty et al.'s
+//!   (2022) seed pool, or a space-filling curve on huge instances), α-nearness candidate lists
+//!   (Helsgaun 2000), local search (Lin–Kernighan chains of 2-opt or sequential 3-opt moves,
+//!   Or-opt, segment exchange, mode re-selection by exact DP over a layered graph) and iterated
+//!   local search on several threads whose best tours are merged by a partition crossover,
+//!   within a time or work budget. Deterministic under a work budget.
 //! - [`solve_exact`] is Held–Karp dynamic programming for small instances.
 //! - [`check`] independently verifies a route and recomputes its cost.
 //!

@@ -36,6 +36,12 @@ enum Command {
     Route(cmd::route::Args),
     /// Run a benchmark and print (or write into BENCHMARKS.md) its tables.
     Bench(cmd::bench::Args),
+    /// Order cut contours and plotter strokes (SVG, DXF, G-code, JSON): least rapid travel, holes first.
+    Order(Box<cmd::order::Args>),
+    /// Plan 2.5D pocket machining: toolpath cells per tool linked with the least airtime (Castelino et al. 2003).
+    Machine(cmd::machine::Args),
+    /// Start the web application: machine set-up, programs in 3D, solves with live progress, layup.
+    Serve(cmd::serve::Args),
     /// Plan spray forming or painting: flat patches, passes, one robot path and the predicted
     /// thickness (Tewolde & Sheng 2008).
     Spray(Box<cmd::spray::Args>),
@@ -52,6 +58,9 @@ fn main() {
         Command::Verify(args) => cmd::verify::run(args),
         Command::Route(args) => cmd::route::run(args),
         Command::Bench(args) => cmd::bench::run(args),
+        Command::Order(args) => cmd::order::run(*args),
+        Command::Machine(args) => cmd::machine::run(args),
+        Command::Serve(args) => cmd::serve::run(args),
         Command::Spray(args) => cmd::spray::run(*args),
     };
     std::process::exit(exit::report(result));

@@ -79,7 +79,11 @@ impl Analytic {
             if !x.is_finite() {
                 return Err(fail(format!("{k} = {v} is not finite")));
             }
-            keys.push((k.trim().to_ascii_lowercase(), x));
+            let k = k.trim().to_ascii_lowercase();
+            if keys.iter().any(|(n, _)| *n == k) {
+                return Err(fail(format!("{k} is given twice")));
+            }
+            keys.push((k, x));
         }
         let allowed: &[&str] = match kind {
             "plane" => &["a", "b"],
@@ -91,7 +95,7 @@ impl Analytic {
         if let Some((k, _)) = keys.iter().find(|(k, _)| !allowed.contains(&k.as_str())) {
             return Err(fail(format!("unknown key '{k}' for a {kind} (expected {})", allowed.join(", "))));
         }
-        let get = |k: &str| keys.iter().rev().find(|(n, _)| n == k).map(|&(_, v)| v);
+        let get = |k: &str| keys.iter().find(|(n, _)| n == k).map(|&(_, v)| v);
         let need = |k: &str| get(k).ok_or_else(|| fail(format!("missing {k}=")));
         let positive = |k: &str| -> Result<f64, ParseError> {
             let v = need(k)?;
@@ -132,6 +136,26 @@ impl Analytic {
                 Analytic::Sphere { r: positive("r")?, lat0: lat0.max(-PI / 2.0), lat1: lat1.min(PI / 2.0) }
             }
         })
+    }
+
+    /// The same surface with every length multiplied by `f` (a change of units); angles kept.
+    pub fn scaled(&self, f: f64) -> Analytic {
+        match *self {
+            Analytic::Plane { a, b } => Analytic::Plane { a: a * f, b: b * f },
+            Analytic::Cylinder { r, l, a0, a1 } => Analytic::Cylinder { r: r * f, l: l * f, a0, a1 },
+            Analytic::Cone { r0, r1, l, a0, a1 } => Analytic::Cone { r0: r0 * f, r1: r1 * f, l: l * f, a0, a1 },
+            Analytic::Sphere { r, lat0, lat1 } => Analytic::Sphere { r: r * f, lat0, lat1 },
+        }
+    }
+
+    /// The largest length of the description (radius, side or length).
+    pub fn size(&self) -> f64 {
+        match *self {
+            Analytic::Plane { a, b } => a.max(b),
+            Analytic::Cylinder { r, l, .. } => r.max(l),
+            Analytic::Cone { r0, r1, l, .. } => r0.max(r1).max(l),
+            Analytic::Sphere { r, .. } => r,
+        }
     }
 
     /// Whether u is periodic and the surface closes on itself (full tube, cone or sphere).
@@ -277,6 +301,8 @@ mod tests {
         assert!(e.to_string().contains("not a number"), "{e}");
         assert!(Analytic::parse("cylinder:r=-1,l=2").is_err());
         assert!(Analytic::parse("cylinder:r=1,l=2,q=3").is_err());
+        let e = Analytic::parse("plane:a=100,b=50,A=200").unwrap_err();
+        assert!(e.to_string().contains("a is given twice"), "{e}");
     }
 
     #[test]

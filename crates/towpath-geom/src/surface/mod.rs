@@ -10,7 +10,10 @@ use glam::DVec3;
 
 pub use analytic::{Analytic, ParseError};
 pub use nurbs::{Nurbs, NurbsError};
-pub use tessellate::{tessellate, tessellate_analytic, Tessellation, TessellationError, MAX_TRIANGLES};
+pub use tessellate::{
+    tessellate, tessellate_analytic, tessellate_analytic_within, tessellate_within, Tessellation, TessellationError,
+    TessellationLimits, MAX_TRIANGLES,
+};
 
 /// A parametric surface S(u, v) over a rectangle of parameters.
 pub trait Surface: Send + Sync {

@@ -10,6 +10,7 @@ use super::{ClosestPoint, Surface};
 ///
 /// Control points are stored u-major: point (i, j) is `control[i * count_v + j]`, i along u.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Nurbs {
     /// Degree in u (p).
     pub degree_u: usize,
@@ -36,6 +37,16 @@ pub struct Nurbs {
 pub struct NurbsError(pub String);
 
 impl Nurbs {
+    /// Reads a patch from its JSON text (the fields of [`Nurbs`]; unknown fields are refused) and
+    /// validates it. Syntax and field errors name the line and column.
+    pub fn from_json(text: &str) -> Result<Nurbs, NurbsError> {
+        let n: Nurbs = serde_json::from_str(text).map_err(|e| {
+            NurbsError(format!("line {}, column {}: {}", e.line(), e.column(), strip_position(&e.to_string())))
+        })?;
+        n.validate()?;
+        Ok(n)
+    }
+
     /// A clamped uniform B-spline patch through a grid of control points (`grid[i][j]`, i along u).
     pub fn clamped(degree_u: usize, degree_v: usize, grid: &[Vec<DVec3>]) -> Result<Nurbs, NurbsError> {
         let count_u = grid.len();
@@ -104,6 +115,14 @@ impl Nurbs {
 
     fn weight(&self, k: usize) -> f64 {
         self.weights.get(k).copied().unwrap_or(1.0)
+    }
+}
+
+/// serde_json's message without its trailing " at line L column C".
+fn strip_position(msg: &str) -> &str {
+    match msg.rfind(" at line ") {
+        Some(i) => &msg[..i],
+        None => msg,
     }
 }
 
@@ -270,6 +289,24 @@ impl Surface for Nurbs {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn json_patches_are_read_and_unknown_fields_refused_with_their_line() {
+        let good = r#"{"degree_u": 1, "degree_v": 1, "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+            "count_u": 2, "count_v": 2, "control": [[0, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 0]]}"#;
+        let n = Nurbs::from_json(good).unwrap();
+        assert_eq!(n.eval(1.0, 1.0), DVec3::new(1.0, 1.0, 0.0));
+        // A misspelt field ("weight" for "weights") on line 3 is refused, not ignored.
+        let typo = good.replace("]]}", "]],\n\"weight\": [1, 1, 1, 2]}");
+        let e = Nurbs::from_json(&typo).unwrap_err().to_string();
+        assert!(e.contains("line 3") && e.contains("unknown field `weight`"), "{e}");
+        assert!(!e.contains(" at line "), "the position is said once: {e}");
+        let e = Nurbs::from_json("{\"degree_u\": 1,\n \"degree_v\": x}").unwrap_err().to_string();
+        assert!(e.contains("line 2"), "{e}");
+        // Valid JSON, invalid patch.
+        let e = Nurbs::from_json(&good.replace("\"count_u\": 2", "\"count_u\": 3")).unwrap_err().to_string();
+        assert!(e.contains("control points"), "{e}");
+    }
 
     /// A quarter cylinder as an exact rational quadratic patch: radius 2, height 3.
     fn quarter_cylinder() -> Nurbs {

@@ -31,23 +31,77 @@ pub enum TessellationError {
     /// The tolerances would need more triangles than the limit.
     #[error("tessellation: more than {0} triangles would be needed; loosen D_l2s or L_seg")]
     TooFine(usize),
+    /// A triangle count asked for is above the limit.
+    #[error("tessellation: {0} triangles asked for, more than the limit of {1}")]
+    TooMany(usize, usize),
+    /// A triangle count asked for is below two (one parameter cell).
+    #[error("tessellation: at least 2 triangles are needed, {0} asked for")]
+    TooFew(usize),
+    /// The deadline passed before the tessellation was finished.
+    #[error("tessellation: the time limit was reached before the surface was tessellated")]
+    TimeLimit,
 }
 
 /// Largest tessellation towpath will make.
 pub const MAX_TRIANGLES: usize = 50_000_000;
 
-/// Tessellates an analytic surface (icosphere for a whole sphere, parameter grid otherwise).
-pub fn tessellate_analytic(s: &Analytic, t: &Tessellation) -> Result<Soup, TessellationError> {
-    if let Analytic::Sphere { r, lat0, lat1 } = *s {
-        if lat0 <= -std::f64::consts::FRAC_PI_2 + 1e-12 && lat1 >= std::f64::consts::FRAC_PI_2 - 1e-12 {
-            return icosphere(r, t);
+/// Bounds on the work of a tessellation, checked before anything is allocated and during it.
+#[derive(Debug, Clone, Copy)]
+pub struct TessellationLimits {
+    /// Most triangles to make (at most [`MAX_TRIANGLES`]).
+    pub max_triangles: usize,
+    /// Give up (with [`TessellationError::TimeLimit`]) after this instant.
+    pub deadline: Option<std::time::Instant>,
+}
+
+impl Default for TessellationLimits {
+    fn default() -> Self {
+        TessellationLimits { max_triangles: MAX_TRIANGLES, deadline: None }
+    }
+}
+
+impl TessellationLimits {
+    fn check_time(&self) -> Result<(), TessellationError> {
+        match self.deadline {
+            Some(d) if std::time::Instant::now() >= d => Err(TessellationError::TimeLimit),
+            _ => Ok(()),
         }
     }
-    tessellate(s, t)
+}
+
+/// Tessellates an analytic surface (icosphere for a whole sphere, parameter grid otherwise).
+pub fn tessellate_analytic(s: &Analytic, t: &Tessellation) -> Result<Soup, TessellationError> {
+    tessellate_analytic_within(s, t, &TessellationLimits::default())
+}
+
+/// [`tessellate_analytic`] within limits of size and time.
+pub fn tessellate_analytic_within(
+    s: &Analytic,
+    t: &Tessellation,
+    limits: &TessellationLimits,
+) -> Result<Soup, TessellationError> {
+    if let Analytic::Sphere { r, lat0, lat1 } = *s {
+        if lat0 <= -std::f64::consts::FRAC_PI_2 + 1e-12 && lat1 >= std::f64::consts::FRAC_PI_2 - 1e-12 {
+            return icosphere(r, t, limits);
+        }
+    }
+    tessellate_within(s, t, limits)
 }
 
 /// Tessellates a parametric surface on a refined parameter grid.
 pub fn tessellate(s: &dyn Surface, t: &Tessellation) -> Result<Soup, TessellationError> {
+    tessellate_within(s, t, &TessellationLimits::default())
+}
+
+/// [`tessellate`] within limits of size and time: the refinement stops with
+/// [`TessellationError::TooFine`] as soon as its next grid would exceed the triangle limit, so
+/// nothing larger than the limit is ever allocated.
+pub fn tessellate_within(
+    s: &dyn Surface,
+    t: &Tessellation,
+    limits: &TessellationLimits,
+) -> Result<Soup, TessellationError> {
+    let max_triangles = limits.max_triangles.min(MAX_TRIANGLES);
     let [[u0, u1], [v0, v1]] = s.domain();
     let (mut nu, mut nv);
     match *t {
@@ -57,6 +111,7 @@ pub fn tessellate(s: &dyn Surface, t: &Tessellation) -> Result<Soup, Tessellatio
             }
             (nu, nv) = (4usize, 4usize);
             for _ in 0..40 {
+                limits.check_time()?;
                 let m = measure(s, nu, nv, [u0, u1], [v0, v1]);
                 let f = |len: f64, dev: f64| (len / l_seg).max((dev / d_l2s).sqrt());
                 let (fu, fv, fd) = (f(m.len[0], m.dev[0]), f(m.len[1], m.dev[1]), f(m.len[2], m.dev[2]));
@@ -74,14 +129,17 @@ pub fn tessellate(s: &dyn Surface, t: &Tessellation) -> Result<Soup, Tessellatio
                     }
                 }
                 (nu, nv) = (gu.max(nu + 1), gv.max(nv + 1));
-                if nu.saturating_mul(nv).saturating_mul(2) > MAX_TRIANGLES {
-                    return Err(TessellationError::TooFine(MAX_TRIANGLES));
+                if nu.saturating_mul(nv).saturating_mul(2) > max_triangles {
+                    return Err(TessellationError::TooFine(max_triangles));
                 }
             }
         }
         Tessellation::Triangles(n) => {
-            if n > MAX_TRIANGLES {
-                return Err(TessellationError::TooFine(MAX_TRIANGLES));
+            if n > max_triangles {
+                return Err(TessellationError::TooMany(n, max_triangles));
+            }
+            if n < 2 {
+                return Err(TessellationError::TooFew(n));
             }
             // Split n/2 cells in proportion to the mean isoline lengths.
             let m = measure(s, 16, 16, [u0, u1], [v0, v1]);
@@ -89,10 +147,15 @@ pub fn tessellate(s: &dyn Surface, t: &Tessellation) -> Result<Soup, Tessellatio
             let cells = (n as f64 / 2.0).max(1.0);
             let ratio = lu / lv; // cell count along u over along v for square cells
             nu = ((cells * ratio).sqrt()).round().max(1.0) as usize;
+            if s.closed_u() {
+                // A tube needs at least three cells around to close on itself.
+                nu = nu.max(3);
+            }
             nv = ((cells / nu as f64).round().max(1.0)) as usize;
         }
     }
-    Ok(grid(s, nu, nv))
+    limits.check_time()?;
+    grid(s, nu, nv, limits)
 }
 
 struct Measure {
@@ -150,13 +213,16 @@ fn measure(s: &dyn Surface, nu: usize, nv: usize, ur: [f64; 2], vr: [f64; 2]) ->
 
 /// Triangulates an (nu × nv)-cell parameter grid, each cell split along its shorter diagonal.
 /// A surface closed along u reuses its first column as its last.
-fn grid(s: &dyn Surface, nu: usize, nv: usize) -> Soup {
+fn grid(s: &dyn Surface, nu: usize, nv: usize, limits: &TessellationLimits) -> Result<Soup, TessellationError> {
     let [[u0, u1], [v0, v1]] = s.domain();
     let closed = s.closed_u();
     let cols = if closed { nu } else { nu + 1 };
     let mut soup = Soup::default();
     soup.positions.reserve(cols * (nv + 1));
     for i in 0..cols {
+        if i % 64 == 0 {
+            limits.check_time()?;
+        }
         let u = u0 + (u1 - u0) * i as f64 / nu as f64;
         for j in 0..=nv {
             soup.positions.push(s.eval(u, v0 + (v1 - v0) * j as f64 / nv as f64));
@@ -178,13 +244,19 @@ fn grid(s: &dyn Surface, nu: usize, nv: usize) -> Soup {
             }
         }
     }
-    soup
+    Ok(soup)
 }
 
 /// A geodesic icosphere (class I, frequency n: 20 n² triangles) of radius r.
-fn icosphere(r: f64, t: &Tessellation) -> Result<Soup, TessellationError> {
+fn icosphere(r: f64, t: &Tessellation, limits: &TessellationLimits) -> Result<Soup, TessellationError> {
+    let max_triangles = limits.max_triangles.min(MAX_TRIANGLES);
     let n = match *t {
-        Tessellation::Triangles(count) => ((count as f64 / 20.0).sqrt().round() as usize).max(1),
+        Tessellation::Triangles(count) => {
+            if count > max_triangles {
+                return Err(TessellationError::TooMany(count, max_triangles));
+            }
+            ((count as f64 / 20.0).sqrt().round() as usize).max(1)
+        }
         Tessellation::Chord { d_l2s, l_seg } => {
             if !(d_l2s > 0.0 && l_seg > 0.0 && d_l2s.is_finite() && l_seg.is_finite()) {
                 return Err(TessellationError::BadTolerance(d_l2s, l_seg));
@@ -200,15 +272,16 @@ fn icosphere(r: f64, t: &Tessellation) -> Result<Soup, TessellationError> {
                     break n;
                 }
                 n += 1.max(n / 8);
-                if 20 * n * n > MAX_TRIANGLES {
-                    return Err(TessellationError::TooFine(MAX_TRIANGLES));
+                if 20 * n * n > max_triangles {
+                    return Err(TessellationError::TooFine(max_triangles));
                 }
             }
         }
     };
-    if 20usize.saturating_mul(n).saturating_mul(n) > MAX_TRIANGLES {
-        return Err(TessellationError::TooFine(MAX_TRIANGLES));
+    if 20usize.saturating_mul(n).saturating_mul(n) > max_triangles {
+        return Err(TessellationError::TooFine(max_triangles));
     }
+    limits.check_time()?;
     let g = (1.0 + 5f64.sqrt()) / 2.0;
     let v = [
         DVec3::new(-1.0, g, 0.0),
@@ -250,6 +323,7 @@ fn icosphere(r: f64, t: &Tessellation) -> Result<Soup, TessellationError> {
     // the same two corners) up to rounding, which welding removes.
     let mut tris = Vec::with_capacity(20 * n * n);
     for f in faces {
+        limits.check_time()?;
         let (a, b, c) = (v[f[0]], v[f[1]], v[f[2]]);
         let pt = |i: usize, j: usize| {
             // i along a→b, j along a→c.
@@ -310,6 +384,35 @@ mod tests {
         // Outward orientation kept.
         let c = mesh.corners(0);
         assert!(mesh.face_normal(0).dot((c[0] + c[1] + c[2]) / 3.0) > 0.0);
+    }
+
+    #[test]
+    fn limits_refuse_before_allocating_and_a_passed_deadline_stops() {
+        let plane = Analytic::parse("plane:a=1000000,b=1000000").unwrap();
+        let limits = TessellationLimits { max_triangles: 100_000, deadline: None };
+        let fine = Tessellation::Chord { d_l2s: 0.05, l_seg: 1.0 };
+        assert_eq!(tessellate_analytic_within(&plane, &fine, &limits), Err(TessellationError::TooFine(100_000)));
+        let many = Tessellation::Triangles(200_000);
+        assert_eq!(
+            tessellate_analytic_within(&plane, &many, &limits),
+            Err(TessellationError::TooMany(200_000, 100_000))
+        );
+        let sphere = Analytic::parse("sphere:r=500").unwrap();
+        assert!(tessellate_analytic_within(&sphere, &many, &limits).is_err());
+        assert_eq!(tessellate_analytic(&plane, &Tessellation::Triangles(1)), Err(TessellationError::TooFew(1)));
+        let past = TessellationLimits { max_triangles: MAX_TRIANGLES, deadline: Some(std::time::Instant::now()) };
+        let coarse = Tessellation::Triangles(1000);
+        assert_eq!(tessellate_analytic_within(&plane, &coarse, &past), Err(TessellationError::TimeLimit));
+        assert_eq!(tessellate_analytic_within(&sphere, &coarse, &past), Err(TessellationError::TimeLimit));
+    }
+
+    #[test]
+    fn a_tube_of_two_triangles_still_closes() {
+        let cyl = Analytic::parse("cylinder:r=300,l=1000").unwrap();
+        let soup = tessellate_analytic(&cyl, &Tessellation::Triangles(2)).unwrap();
+        let (mesh, _) = Mesh::build(&soup, &BuildOptions::default()).unwrap();
+        assert_eq!(mesh.num_faces(), 6);
+        assert_eq!(mesh.boundary_loops().len(), 2);
     }
 
     #[test]

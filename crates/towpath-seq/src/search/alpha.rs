@@ -57,18 +57,15 @@ impl PartialOrd for Item {
 /// Lowest-α neighbours per node.
 const ALPHA_K: usize = 8;
 
-/// Nearest neighbours kept beside them. α alone (8 per node) did worse on instances with
-/// clusters of coincident points: on fl1577 at 5 s, 2 cores, 4.2-4.9 % above the optimum
-/// where the nearest 10 gave 0.46 %; with the nearest 5 added, 0.05-0.14 %. Over 19 TSPLIB
-/// instances of 200-2392 nodes (5 s, 2 cores, seeds 1 and 2) the gaps summed to 3.5 % and
-/// 3.3 %, against 6.2 % and 6.6 % with the nearest 10 and 10.3 % and 8.9 % with α alone.
+/// Nearest neighbours kept beside them: α alone misses neighbours among clusters of coincident
+/// points (fl1577); the measurements are in the history of this constant and BENCHMARKS.md.
 const NEAREST_KEPT: usize = 5;
 
 /// Largest ascent: Polyak steps usually stop improving the bound well before this.
 const MAX_ASCENT: usize = 300;
 
-/// Estimated time of one ascent step per node (a heap-based Prim over ~13 edges a node,
-/// measured 0.45-0.65 µs on pr1002-pcb3038) and of one α pair (a cost and a tree step).
+/// Estimated time of one ascent step per node (a heap-based Prim over ~13 edges a node) and of
+/// one α pair (a cost and a tree step), used to decide whether the lists fit the budget.
 const STEP_SECONDS_PER_NODE: f64 = 7e-7;
 const PAIR_SECONDS: f64 = 1.5e-8;
 

@@ -1,4 +1,4 @@
-//! Construction heuristics: nearest neighbour (with the seed-000 seed pool) and a space-filling
+//! Construction heuristics: nearest neighbour (with Doherty et al.'s (2022) seed pool) and a space-filling
 //! curve for very large instances. Both respect precedence and consecutive groups.
 
 use std::time::Instant;
@@ -154,7 +154,7 @@ pub(crate) fn rotate_to_anchor<C: CostModel>(net: &Net<C>, seq: &mut [u32]) {
     }
 }
 
-/// The seed-000 seed pool: candidate first tasks for nearest neighbour. All tasks when the
+/// Doherty et al.'s (2022) seed pool: candidate first tasks for nearest neighbour. All tasks when the
 /// instance is small; otherwise an evenly spread sample of `limit`. Always includes the task
 /// whose total distance to all others is largest.
 pub(crate) fn seed_pool<C: CostModel>(net: &Net<C>, limit: usize) -> Vec<u32> {

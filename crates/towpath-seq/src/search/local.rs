@@ -1,7 +1,10 @@
-//! Local search: mode change, Or-opt (segment insertion, optionally reversed) and 2-opt, driven by
-//! a queue of "dirty" nodes (don't-look bits). Moves respect precedence (checked incrementally by
-//! marking the moved segment's successors or predecessors while scanning outwards) and
-//! consecutive groups (see [`Net::move_allowed`]).
+//! Local search driven by a queue of "dirty" nodes (don't-look bits): mode change; Lin–Kernighan
+//! chains of 2-opt reversals (reversal-symmetric tours, also under precedence) or, on plain
+//! symmetric one-mode tours, of sequential 3-opt moves (`lk3`); Or-opt (segments of 1–3 tasks
+//! and whole group blocks, optionally reversed); and the segment exchange (path-preserving
+//! 3-opt). Moves respect precedence (checked incrementally by marking the moved segment's
+//! successors or predecessors while scanning outwards) and consecutive groups (see
+//! [`Net::move_allowed`]).
 
 use std::collections::VecDeque;
 use std::time::Instant;
@@ -32,15 +35,11 @@ const LK_DEPTH: usize = 6;
 
 /// Alternatives tried at the first level of a Lin–Kernighan move on tours of at least
 /// `LK_BREADTH_FROM` nodes without 3-opt steps (deeper levels, and every level on smaller
-/// tours, are greedy). Measured at 10 s on 2 cores, 6 seeds, on TSPLIB tours with chains of
-/// 2-opt and 3-opt steps 6 deep: pcb3038 0.31 % → 0.25 % and fnl4461 0.37 % → 0.29 % above the
-/// optimum with 3 alternatives; pr1002 did worse (0.25 % → 0.34 %).
+/// tours, are greedy): backtracking pays on tours of thousands of nodes, not on smaller ones.
 const LK_BREADTH: usize = 3;
 const LK_BREADTH_FROM: usize = 2000;
-/// Above this size the first level stays greedy: on 100,000 random strokes (two modes each) the
-/// backtracking descent from the space-filling curve alone took 48 s of a 60 s limit and left
-/// the answer worse and not 2-opt-local-optimal (greedy: a full search in the limit, 0 improving
-/// 2-opt moves).
+/// Above this size the first level stays greedy: backtracking from a space-filling-curve start
+/// on 100,000-node tours takes most of a minute before the first kick.
 const LK_BREADTH_UP_TO: usize = 20_000;
 
 /// Longest tentative reversal of a Lin–Kernighan step on tours above `LK_BREADTH_UP_TO` nodes,
@@ -233,11 +232,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         }
         if self.lk3 {
             // Or-opt and the segment exchange are sequential 3-opt moves the chains already try
-            // (from the candidates). Skipping them gave 40 % more kicks and, at 10 s on 2 cores,
-            // interleaved seeds 5-12, pcb3038 0.013-0.025 % against 0.11-0.16 % above the
-            // optimum by median, fnl4461 0.082-0.084 % against 0.073-0.091 %; ten TSPLIB
-            // instances of 532-2392 nodes at 5 s, seeds 1-4: gap sums 0.64 % against 0.71 %
-            // for the chains of stop 14 (without d1291, which is bimodal: 0.51 % against 0.44 %).
+            // (from the candidates); skipping them leaves time for more kicks.
             return false;
         }
         if self.try_or_opt(tour, v) {
@@ -795,8 +790,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
 
     /// A Lin–Kernighan move built from a chain of 2-opt reversals (reversal-symmetric instances;
     /// under precedence, one mode per task and only reversals with no precedence pair inside,
-    /// which lifted TSPLIB's prob.100 from 1213 to 1158 by median, below its best known 1163;
-    /// 10 s, 2 cores). From t1 and its tour neighbour t2, a step adds an arc t2–t3 to a
+    /// which is what SOP instances such as TSPLIB's prob.100 need). From t1 and its tour neighbour t2, a step adds an arc t2–t3 to a
     /// candidate t3, removes t3's arc to t4 (the neighbour that keeps a tour) and reverses the
     /// stretch between, so the tour stays closed. At each level every candidate's closing is
     /// priced exactly without touching the tour (that level is plain 2-opt); if none improves, the

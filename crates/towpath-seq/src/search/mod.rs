@@ -297,9 +297,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
             }
         }
         // Where the chains' tours can be merged, the merge keeps every chain's improvements
-        // (10 s, 2 cores, interleaved seeds 9-13: pcb3038 0.134 -> 0.123 %, fnl4461 0.148 ->
-        // 0.121 % above the optimum by median; ten TSPLIB instances of 532-2392 nodes at 5 s:
-        // gap sums 1.29 -> 1.24 %, within noise).
+        // instead of only the best chain's.
         if merge_chains {
             for c in chains.iter() {
                 if let Some((seq, changed)) = merge::partition_crossover(&net, &best, &c.best, eps) {
@@ -353,14 +351,9 @@ fn budget_used(opts: &SolveOptions, t0: Instant, iterations: u64) -> Option<f64>
 /// Temperature of the kick acceptance at a fraction `frac` of the budget. Under precedence,
 /// where kicks are few and the search easily stays in one basin, a kick that makes the tour
 /// dearer by Δ is kept with probability exp(-Δ/T) (simulated-annealing acceptance); T starts at
-/// twice the mean arc of the best tour and falls as (1 - frac)². Measured on ten TSPLIB SOP and
-/// SOPLIB instances at equal work (10,000 kicks, one thread, 3 seeds): the mean gap to the best
-/// known fell from 6.9 % to 4.7 % with a start at the mean arc (ft70.2 and kro124p.1 optimal in
-/// 2/3 and 2/3 runs, were 0/3). With the faster local search (`prunes_by_gain`) a 10 s search
-/// does 4x more kicks, and there twice the mean arc did better (10 s, 2 cores, medians of 3
-/// seeds: prob.100 1233 -> 1193, kro124p.3 50168 -> 49499, R.300.100.15 3272 -> 3233,
-/// R.200.100.1 79 -> 80, R.200.100.15 and ft70.3 equal; half did worse, three times mixed).
-/// Other problems keep "not worse" acceptance.
+/// twice the mean arc of the best tour and falls as (1 - frac)² (chosen on TSPLIB SOP and
+/// SOPLIB instances; the figures are in the history of this function). Other problems keep
+/// "not worse" acceptance.
 fn acceptance_temperature<C: CostModel>(net: &Net<C>, best: Cost, frac: f64) -> Cost {
     if !net.has_prec {
         return 0.0;

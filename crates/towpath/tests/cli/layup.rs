@@ -36,6 +36,8 @@ fn cylinder_helix_ply_with_gcode_and_csv() {
     assert_eq!(s["courses"], 14);
     assert!(s["coverage_percent"].as_f64().unwrap() > 99.5, "{s}");
     assert!(s["max_angle_deviation_deg"].as_f64().unwrap() < 0.05);
+    // Nothing looks wrong: no warning (the sections round the tube count its courses once).
+    assert_eq!(s["warnings"].as_array().map(Vec::len), Some(0), "{s}");
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(d.join("c.json")).unwrap()).unwrap();
     assert_eq!(doc["format"], "towpath-courses");
     assert_eq!(doc["courses"].as_array().unwrap().len(), 14);
@@ -336,4 +338,268 @@ fn layup_gcode_is_optimized_bidirectionally_and_verified() {
     let v = json_of(&towpath_in(&d, &args));
     assert_eq!(v["verified"], true, "{v}");
     assert_eq!(v["courses"].as_u64(), Some(courses));
+}
+
+/// Runs `towpath layup ARGS` in `dir`: exit code, stdout, stderr.
+fn layup_in(dir: &std::path::Path, args: &[&str]) -> (i32, String, String) {
+    let mut c = towpath();
+    c.current_dir(dir).arg("layup").args(args);
+    run(&mut c)
+}
+
+#[test]
+fn bad_numbers_sizes_and_descriptions_are_refused_quickly_and_nothing_is_written() {
+    let d = scratch("refuse");
+    std::fs::write(
+        d.join("typo.json"),
+        "{\"degree_u\": 1, \"degree_v\": 1, \"knots_u\": [0, 0, 1, 1], \"knots_v\": [0, 0, 1, 1],\n\
+         \"count_u\": 2, \"count_v\": 2, \"control\": [[0, 0, 0], [0, 100, 0], [100, 0, 0], [100, 100, 0]],\n\
+         \"weight\": [1, 1, 1, 1]}",
+    )
+    .unwrap();
+    // A 10 × 10 grid of 1 km cells: 10 km across.
+    let mut grid = String::new();
+    for j in 0..=10 {
+        for i in 0..=10 {
+            grid.push_str(&format!("v {} {} 0\n", i as f64 * 1e6, j as f64 * 1e6));
+        }
+    }
+    for j in 0..10 {
+        for i in 0..10 {
+            let a = j * 11 + i + 1;
+            grid.push_str(&format!("f {a} {} {}\nf {a} {} {}\n", a + 1, a + 12, a + 12, a + 11));
+        }
+    }
+    std::fs::write(d.join("grid.obj"), grid).unwrap();
+    let plate = ["plane:a=200,b=100", "--tows", "4"];
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--tow-width", "6.35", "--weld-tolerance", "-1"], "weld tolerance must not be negative"),
+        (vec!["--tow-width", "6.35", "--weld-tolerance", "NaN"], "weld tolerance must be a finite number"),
+        (vec!["--tow-width", "6.35", "--min-steering-radius", "NaN"], "minimum steering radius must be a finite"),
+        (vec!["--tow-width", "6.35", "--min-steering-radius", "-5"], "minimum steering radius must be positive"),
+        (vec!["--tow-width", "6.35", "--d-l2s", "inf"], "D_l2s must be a finite"),
+        (vec!["--tow-width", "6.35", "--l-seg", "0"], "L_seg must be positive"),
+        (vec!["--tow-width", "6.35", "--angle", "1e300"], "ply angle"),
+        (vec!["--tow-width", "6.35", "--start", "1e308,0,0"], "start point lies"),
+        (vec!["--tow-width", "6.35", "--start", "1e5,0,0"], "start point is"),
+        (vec!["--tow-width", "6.35", "--axis", "0,0,0"], "reference axis"),
+        (vec!["--tow-width", "NaN"], "tow width must be a finite"),
+        (vec!["--tow-width", "-6.35"], "tow width must be positive"),
+        (vec!["--tow-width", "1e9"], "outside 0.01 to 1000 mm"),
+        (vec!["--tow-width", "1e-9"], "outside 0.01 to 1000 mm"),
+        (vec!["--tow-width", "1e-3"], "outside 0.01 to 1000 mm"),
+        (vec!["--tow-width", "6.35", "--time-limit", "0"], "--time-limit"),
+        (vec!["--tow-width", "6.35", "--time-limit", "NaN"], "--time-limit"),
+        (vec!["--tow-width", "6.35", "--triangles", "100000000"], "more than the limit of 4000000"),
+        (vec!["--tow-width", "6.35", "--d-l2s", "1e-9", "--l-seg", "1e-6"], "more than 4000000 triangles"),
+    ];
+    for (extra, expected) in cases {
+        let mut args: Vec<&str> = plate.to_vec();
+        args.extend(&extra);
+        if !extra.contains(&"--angle") {
+            args.extend(["--angle", "30"]);
+        }
+        args.extend(["-o", "out.json", "--gcode", "out.nc"]);
+        let t = std::time::Instant::now();
+        let (code, _, err) = layup_in(&d, &args);
+        assert_eq!(code, 2, "{extra:?}: {err}");
+        assert!(err.contains(expected), "{extra:?}: expected '{expected}' in: {err}");
+        assert!(t.elapsed().as_secs_f64() < 20.0, "{extra:?} took {:?}", t.elapsed());
+        assert!(!d.join("out.json").exists() && !d.join("out.nc").exists(), "{extra:?} wrote files");
+    }
+    let others: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["plane:a=200,b=100,a=300"], "a is given twice"),
+        (vec!["nurbs:typo.json"], "typo.json: NURBS patch: line 3"),
+        (vec!["grid.obj"], "courses, more than the limit"),
+    ];
+    for (surface, expected) in others {
+        let mut args = surface.clone();
+        args.extend(["--angle", "30", "--tows", "16", "--tow-width", "6.35", "-o", "out.json"]);
+        let (code, _, err) = layup_in(&d, &args);
+        assert_eq!(code, 2, "{surface:?}: {err}");
+        assert!(err.contains(expected), "{surface:?}: expected '{expected}' in: {err}");
+        assert!(!d.join("out.json").exists());
+    }
+    // The courses file is JSON: a name for another format is a slip.
+    let (code, _, err) =
+        layup_in(&d, &["plane:a=200,b=100", "--angle", "0", "--tow-width", "6.35", "--tows", "4", "-o", "p.nc"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("-o writes the courses as JSON"), "{err}");
+}
+
+#[test]
+fn the_time_limit_stops_the_whole_run_and_nothing_is_written() {
+    let d = scratch("time");
+    // About a thousand courses of 0.2 mm: tens of seconds of work, stopped at a quarter second.
+    let t = std::time::Instant::now();
+    let (code, _, err) = layup_in(
+        &d,
+        &[
+            "plane:a=200,b=100",
+            "--angle",
+            "30",
+            "--tows",
+            "4",
+            "--tow-width",
+            "0.05",
+            "--time-limit",
+            "0.25",
+            "-o",
+            "p.json",
+        ],
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("time limit was reached") && err.contains("--time-limit"), "{err}");
+    assert!(t.elapsed().as_secs_f64() < 10.0, "stopped after {:?}", t.elapsed());
+    assert!(!d.join("p.json").exists());
+}
+
+#[test]
+fn units_convert_the_inputs_and_implausible_sizes_are_warned_about() {
+    let d = scratch("units");
+    let json = |args: &[&str]| {
+        let (code, out, err) = layup_in(&d, args);
+        assert_eq!(code, 0, "{err}");
+        (serde_json::from_str::<serde_json::Value>(&out).expect("one JSON object"), err)
+    };
+    let common = ["--angle", "30", "--tows", "4", "--json"];
+    // The same plate and tows in mm, in inches, and in inches with a tow width in mm.
+    let (mm, _) = json(&[&["plane:a=254,b=127", "--tow-width", "6.35", "-o", "mm.json"][..], &common].concat());
+    let (inch, _) =
+        json(&[&["plane:a=10,b=5", "--units", "in", "--tow-width", "0.25", "-o", "in.json"][..], &common].concat());
+    let (mixed, _) =
+        json(&[&["plane:a=10,b=5", "--units", "in", "--tow-width", "6.35mm", "-o", "mx.json"][..], &common].concat());
+    for s in [&inch, &mixed] {
+        assert_eq!(s["units"], "in");
+        assert!((s["tow_width_mm"].as_f64().unwrap() - 6.35).abs() < 1e-9, "{s}");
+        assert_eq!(s["courses"], mm["courses"]);
+        let (a, b) = (s["ply_area"].as_f64().unwrap(), mm["ply_area"].as_f64().unwrap());
+        assert!((a - 254.0 * 127.0).abs() < 1e-6 * a && (a - b).abs() < 1e-6 * a, "{a} vs {b}");
+        let (a, b) = (s["course_length"].as_f64().unwrap(), mm["course_length"].as_f64().unwrap());
+        assert!((a - b).abs() < 1e-6 * b, "{a} vs {b}");
+        assert_eq!(s["warnings"].as_array().unwrap().len(), 0, "{s}");
+    }
+    // The inch plate read as millimetres with an inch tow width: a 11 mm plate, 0.25 mm tows.
+    let (s, err) = json(&[&["plane:a=10,b=5", "--tow-width", "0.25", "-o", "bad.json"][..], &common].concat());
+    let kinds: Vec<&str> = s["warnings"].as_array().unwrap().iter().map(|w| w["kind"].as_str().unwrap()).collect();
+    assert!(kinds.contains(&"surface_size") && kinds.contains(&"tow_width"), "{kinds:?}");
+    assert!(err.contains("warning: the surface is 11.18 mm across") && err.contains("in: 284 mm"), "{err}");
+    // A plate narrower than one course.
+    let (s, _) = json(&[&["plane:a=300,b=10", "--tow-width", "6.35", "-o", "n.json"][..], &common].concat());
+    let kinds: Vec<&str> = s["warnings"].as_array().unwrap().iter().map(|w| w["kind"].as_str().unwrap()).collect();
+    assert!(kinds.contains(&"course_wider_than_ply"), "{kinds:?}");
+}
+
+#[test]
+fn the_summary_names_units_welding_every_file_and_small_areas() {
+    let d = scratch("summary");
+    // An unwelded STL (every triangle its own three vertices) of a small plate.
+    let (code, _, err) = layup_in(
+        &d,
+        &[
+            "plane:a=6,b=4",
+            "--angle",
+            "0",
+            "--tows",
+            "2",
+            "--tow-width",
+            "1",
+            "--triangles",
+            "8",
+            "-o",
+            "a.json",
+            "--write-mesh",
+            "plate.stl",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let (code, out, err) = layup_in(
+        &d,
+        &[
+            "plate.stl",
+            "--angle",
+            "0",
+            "--tows",
+            "2",
+            "--tow-width",
+            "1",
+            "-o",
+            "b.txt",
+            "--gcode",
+            "b.nc",
+            "--csv",
+            "b.csv",
+            "--write-mesh",
+            "b.obj",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("units           : surface and lengths in mm; outputs in mm"), "{out}");
+    assert!(out.contains("welding         : 24 → 9 vertices"), "{out}");
+    // 24 mm² is not "0 mm2".
+    assert!(out.contains("% of 24 mm²"), "{out}");
+    assert!(
+        out.contains("wrote           : b.txt (courses JSON), b.nc (G-code), b.csv (CSV), b.obj (mesh, mm)"),
+        "{out}"
+    );
+    for f in ["b.txt", "b.nc", "b.csv", "b.obj"] {
+        assert!(d.join(f).exists(), "{f}");
+    }
+    // A plate one course wide: one course, said so.
+    let (code, out, _) =
+        layup_in(&d, &["plane:a=6,b=2", "--angle", "0", "--tows", "2", "--tow-width", "1", "-o", "c.json"]);
+    assert_eq!(code, 0);
+    assert!(out.contains("courses         : 1 ("), "{out}");
+    // Every example in --help runs as written: each names the required --tow-width and --tows.
+    let (code, help, _) = run(towpath().args(["layup", "--help"]));
+    assert_eq!(code, 0);
+    let examples: Vec<&str> = help.lines().filter(|l| l.trim_start().starts_with("towpath layup ")).collect();
+    assert!(examples.len() >= 3, "{help}");
+    for e in examples {
+        assert!(e.contains("--tow-width") && e.contains("--tows") && e.contains("--angle") && e.contains("-o "), "{e}");
+    }
+}
+
+#[test]
+fn a_plate_of_two_triangles_is_covered_like_a_fine_one() {
+    let d = scratch("coarse");
+    let ply = |triangles: &str, out: &str| {
+        let (code, out, err) = layup_in(
+            &d,
+            &[
+                "plane:a=100,b=100",
+                "--triangles",
+                triangles,
+                "--angle",
+                "30",
+                "--tow-width",
+                "6.35",
+                "--tows",
+                "4",
+                "--coverage",
+                "100",
+                "--start",
+                "50,50,0",
+                "-o",
+                out,
+                "--gcode",
+                &format!("{out}.nc"),
+                "--json",
+            ],
+        );
+        assert_eq!(code, 0, "{err}");
+        serde_json::from_str::<serde_json::Value>(&out).unwrap()
+    };
+    let (coarse, fine) = (ply("2", "c.json"), ply("20000", "f.json"));
+    assert_eq!(coarse["mesh_triangles"], 2);
+    assert_eq!(coarse["courses"], fine["courses"]);
+    assert!(coarse["coverage_percent"].as_f64().unwrap() > 99.0, "{coarse}");
+    let (a, b) = (coarse["tow_length"].as_f64().unwrap(), fine["tow_length"].as_f64().unwrap());
+    assert!((a - b).abs() < 0.01, "laid tow length {a} vs {b}");
+    // No course of the program is a point.
+    let g = std::fs::read_to_string(d.join("c.json.nc")).unwrap();
+    for line in g.lines().filter(|l| l.starts_with("(COURSE ")) {
+        let len: f64 = line.split("LENGTH=").nth(1).unwrap().trim_end_matches(')').parse().unwrap();
+        assert!(len > 25.0, "{line}");
+    }
 }

@@ -1,0 +1,100 @@
+//! `towpath machine` end to end: the G-code read back (one plunge per cell, cells in a legal
+//! order, every cut move inside its feature), the report written, bad parts refused.
+
+use super::common::*;
+
+const PART: &str = r#"{"format": "towpath-part/1", "name": "plate", "origin": [0, 0], "clearance": 5,
+ "features": [
+  {"id": "face", "boundary": [[0,0],[200,0],[200,100],[0,100]], "depth": 1},
+  {"id": "dumbbell", "parent": "face", "depth": 6,
+   "boundary": [[10,10],[50,10],[50,26],[90,26],[90,10],[130,10],[130,50],[90,50],[90,34],[50,34],[50,50],[10,50]]},
+  {"id": "ring", "parent": "face", "depth": 4, "boundary": [[140,10],[190,10],[190,90],[140,90]],
+   "islands": [[[155,35],[175,35],[175,65],[155,65]]]},
+  {"id": "slot", "parent": "dumbbell", "depth": 10, "boundary": [[20,20],[40,20],[40,40],[20,40]]}
+ ],
+ "tools": [{"number": 1, "radius": 3, "step_over": 2, "features": ["face", "dumbbell", "ring"]},
+           {"number": 2, "radius": 1, "step_over": 1.5, "features": ["slot", "ring"]}]}"#;
+
+#[test]
+fn machines_a_part_and_the_gcode_keeps_the_hierarchy() {
+    let dir = scratch("machine");
+    let part = dir.join("part.json");
+    std::fs::write(&part, PART).unwrap();
+    let nc = dir.join("part.nc");
+    let html = dir.join("part.html");
+    let o = towpath_out(&[
+        "machine",
+        part.to_str().unwrap(),
+        "-o",
+        nc.to_str().unwrap(),
+        "--report",
+        html.to_str().unwrap(),
+        "--iterations",
+        "100",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    let v = json_of(&o);
+    let g = std::fs::read_to_string(&nc).unwrap();
+    let report = std::fs::read_to_string(&html).unwrap();
+    assert!(report.contains("<svg") && report.contains("T1") && report.contains("T2"));
+    let tools = v["tools"].as_array().unwrap();
+    assert_eq!(tools.len(), 2);
+    // One plunge per cell, per tool, in the order reported; parents before children.
+    let cells: Vec<String> =
+        g.lines().filter_map(|l| l.strip_prefix("(cell ").map(|s| s.trim_end_matches(')').to_string())).collect();
+    let reported: Vec<String> = tools
+        .iter()
+        .flat_map(|t| t["order"].as_array().unwrap().iter().map(|c| c.as_str().unwrap().to_string()))
+        .collect();
+    assert_eq!(cells, reported);
+    let plunges = g.lines().filter(|l| l.starts_with("G1 Z")).count();
+    assert_eq!(plunges, cells.len());
+    let t1: Vec<&str> = tools[0]["order"].as_array().unwrap().iter().map(|c| c.as_str().unwrap()).collect();
+    let first_child = t1.iter().position(|c| !c.starts_with("face")).unwrap();
+    assert!(
+        t1[..first_child].iter().all(|c| c.starts_with("face"))
+            && t1[first_child..].iter().all(|c| !c.starts_with("face"))
+    );
+    // The dumbbell splits for T1: its split cell comes before its two halves.
+    let db: Vec<&&str> = t1.iter().filter(|c| c.starts_with("dumbbell")).collect();
+    assert_eq!(db.len(), 3);
+    assert_eq!(*db[0], "dumbbella");
+    assert!(v["rapid_after"].as_f64().unwrap() <= v["rapid_before"].as_f64().unwrap() + 1e-9);
+    // Castelino's transformation plans the same part legally.
+    let o = towpath_out(&[
+        "machine",
+        part.to_str().unwrap(),
+        "--solver",
+        "castelino",
+        "--time-limit",
+        "1",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    let c = json_of(&o);
+    assert_eq!(c["solver"], "castelino");
+    assert_eq!(c["tools"][0]["cells"], v["tools"][0]["cells"]);
+}
+
+#[test]
+fn bad_parts_are_refused() {
+    let dir = scratch("machine-bad");
+    let part = dir.join("bad.json");
+    std::fs::write(&part, PART.replace("\"radius\": 3", "\"radius\": 0")).unwrap();
+    let (code, _, err) = run(towpath().args(["machine", part.to_str().unwrap()]));
+    assert_eq!(code, 2);
+    assert!(err.contains("tools[0] (T1)") && err.contains("radius"), "{err}");
+    std::fs::write(
+        &part,
+        PART.replace("[[140,10],[190,10],[190,90],[140,90]]", "[[140,10],[190,90],[190,10],[140,90]]"),
+    )
+    .unwrap();
+    let (code, _, err) = run(towpath().args(["machine", part.to_str().unwrap()]));
+    assert_eq!(code, 2);
+    assert!(err.contains("\"ring\"") && err.contains("crosses itself"), "{err}");
+    let (code, _, err) = run(towpath().args(["machine", dir.join("missing.json").to_str().unwrap()]));
+    assert_eq!(code, 2, "{err}");
+}
