@@ -40,6 +40,9 @@ enum Command {
     Machine(cmd::machine::Args),
     /// Start the web application: machine set-up, programs in 3D, solves with live progress, layup.
     Serve(cmd::serve::Args),
+    /// Plan spray forming or painting: flat patches, passes, one robot path and the predicted
+    /// thickness (Tewolde & Sheng 2008).
+    Spray(Box<cmd::spray::Args>),
 }
 
 fn main() {
@@ -55,6 +58,7 @@ fn main() {
         Command::Order(args) => cmd::order::run(*args),
         Command::Machine(args) => cmd::machine::run(args),
         Command::Serve(args) => cmd::serve::run(args),
+        Command::Spray(args) => cmd::spray::run(*args),
     };
     std::process::exit(exit::report(result));
 }

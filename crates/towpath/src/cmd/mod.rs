@@ -12,4 +12,5 @@ pub mod route;
 pub mod serve;
 pub mod solve;
 pub mod solver_args;
+pub mod spray;
 pub mod verify;

@@ -14,3 +14,4 @@ mod outputs_and_pipes;
 mod route;
 mod serve;
 mod solve;
+mod spray;
