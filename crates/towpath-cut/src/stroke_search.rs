@@ -16,8 +16,8 @@
 //! - **Or-opt**: a segment of 1–3 pieces moves next to a near piece, forwards or reversed (a
 //!   single piece also with its best mode there);
 //! - **perturbation**: segment-swap kicks (a double bridge of two adjacent segments of up to
-//!   50 pieces), each followed by local search from the changed arcs and undone when the tour
-//!   got dearer, while the budget lasts.
+//!   50 pieces; several at once while the search stagnates), each followed by local search from
+//!   the changed arcs and undone when the tour got dearer, while the budget lasts.
 //!
 //! Dirty nodes are kept in a queue (don't-look bits). Precedence pairs are checked per move
 //! (only the pieces a move passes or reverses are looked at). Every move is applied whole, so
@@ -783,6 +783,7 @@ impl<'a> StrokeSearch<'a> {
             (None, None) => 0,
         };
         let mut tries = 0u64;
+        let mut stagnation = 0u64;
         while stats.kicks < max_kicks && !self.cut {
             if tries & 15 == 0 && self.deadline.is_some_and(|d| Instant::now() >= d) {
                 break;
@@ -791,17 +792,29 @@ impl<'a> StrokeSearch<'a> {
             let before = self.cost;
             self.journal.clear();
             self.journaling = true;
-            let Some(nodes) = self.kick(&mut rng) else {
-                self.undo_all(before);
-                // Kicks that found no legal place still count, so a work budget always ends.
-                stats.kicks += 1;
-                continue;
-            };
+            // Kicks grow stronger (several swaps at once) while the search stagnates.
+            let strength = 1 + (stagnation / (2 * self.n as u64 + 50)) % 4;
+            let mut kicked = false;
+            for _ in 0..strength {
+                if let Some(nodes) = self.kick(&mut rng) {
+                    self.touch(&nodes);
+                    kicked = true;
+                }
+            }
+            // Kicks that found no legal place still count, so a work budget always ends.
             stats.kicks += 1;
-            self.touch(&nodes);
+            if !kicked {
+                self.undo_all(before);
+                continue;
+            }
             self.run();
             if self.cost > before {
                 self.undo_all(before);
+            }
+            if self.cost < before - self.eps {
+                stagnation = 0;
+            } else {
+                stagnation += 1;
             }
             self.journaling = false;
         }
@@ -871,4 +884,179 @@ fn neighbours(ends: &[Vec<(P2, P2)>]) -> Vec<Vec<u32>> {
         out.push(list);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A random job: open strokes (some not reversible), closed contours with several entry
+    /// candidates, optional start and precedence pairs (from lower to higher index, so acyclic).
+    fn job(seed: u64, n: usize, start: bool, prec: bool) -> (Vec<Vec<(P2, P2)>>, Vec<(usize, usize)>, Option<P2>) {
+        let mut rng = Rng(seed);
+        let mut p = || [rng.below(1000) as f64 / 10.0, rng.below(1000) as f64 / 10.0];
+        let mut ends = Vec::new();
+        for t in 0..n {
+            let kind = t % 4;
+            let (a, b) = (p(), p());
+            ends.push(match kind {
+                0 | 1 => vec![(a, b), (b, a)],
+                2 => vec![(a, b)],
+                _ => vec![(a, a), (b, b), (p(), p())].into_iter().map(|(e, _)| (e, e)).collect(),
+            });
+        }
+        let mut pairs = Vec::new();
+        if prec {
+            let mut r = Rng(seed ^ 77);
+            for _ in 0..n / 3 {
+                let (x, y) = (r.below(n), r.below(n));
+                if x < y {
+                    pairs.push((x, y));
+                }
+            }
+        }
+        (ends, pairs, if start { Some(p()) } else { None })
+    }
+
+    /// The route's pen-up length, recomputed from the steps alone.
+    fn route_cost(ends: &[Vec<(P2, P2)>], start: Option<P2>, steps: &[(usize, u32)]) -> f64 {
+        let mut at = start;
+        let mut c = 0.0;
+        for &(t, m) in steps {
+            let (e, x) = ends[t][m as usize];
+            if let Some(a) = at {
+                c += ((a[0] - e[0]).powi(2) + (a[1] - e[1]).powi(2)).sqrt();
+            }
+            at = Some(x);
+        }
+        c
+    }
+
+    fn feasible(ends: &[Vec<(P2, P2)>], pairs: &[(usize, usize)], steps: &[(usize, u32)]) -> bool {
+        let mut at = vec![usize::MAX; ends.len()];
+        for (k, &(t, m)) in steps.iter().enumerate() {
+            if t >= ends.len() || at[t] != usize::MAX || m as usize >= ends[t].len() {
+                return false;
+            }
+            at[t] = k;
+        }
+        at.iter().all(|&k| k != usize::MAX) && pairs.iter().all(|&(a, b)| at[a] < at[b])
+    }
+
+    /// The optimum by enumerating every order and every mode.
+    fn brute(ends: &[Vec<(P2, P2)>], pairs: &[(usize, usize)], start: Option<P2>) -> f64 {
+        fn go(
+            ends: &[Vec<(P2, P2)>],
+            pairs: &[(usize, usize)],
+            at: Option<P2>,
+            done: &mut Vec<bool>,
+            left: usize,
+            acc: f64,
+            best: &mut f64,
+        ) {
+            if left == 0 {
+                *best = best.min(acc);
+                return;
+            }
+            for t in 0..ends.len() {
+                if done[t] || pairs.iter().any(|&(a, b)| b == t && !done[a]) {
+                    continue;
+                }
+                done[t] = true;
+                for &(e, x) in &ends[t] {
+                    let d = at.map_or(0.0, |a| ((a[0] - e[0]).powi(2) + (a[1] - e[1]).powi(2)).sqrt());
+                    go(ends, pairs, Some(x), done, left - 1, acc + d, best);
+                }
+                done[t] = false;
+            }
+        }
+        let mut best = f64::INFINITY;
+        go(ends, pairs, start, &mut vec![false; ends.len()], ends.len(), 0.0, &mut best);
+        best
+    }
+
+    /// A feasible start: pieces in index order (precedence pairs go from lower to higher).
+    fn start_tour(n: usize) -> Vec<(usize, u32)> {
+        (0..n).map(|t| (t, 0)).collect()
+    }
+
+    #[test]
+    fn every_move_keeps_a_valid_tour_and_its_cost() {
+        for seed in 0..60u64 {
+            let n = 12 + (seed as usize % 25);
+            let (ends, pairs, start) = job(seed, n, seed % 2 == 0, seed % 3 == 0);
+            let mut s = StrokeSearch::new(&ends, &pairs, start, &start_tour(n));
+            // Each node's moves one at a time, checked after every applied move.
+            for round in 0..4 {
+                for v in 0..n as u32 {
+                    let before = s.cost();
+                    let moved = s.try_state(v) || s.try_two_opt(v) || s.try_or_opt(v);
+                    let steps = s.steps();
+                    assert!(feasible(&ends, &pairs, &steps), "seed {seed} round {round}: infeasible after a move");
+                    let exact = route_cost(&ends, start, &steps);
+                    assert!((exact - s.cost()).abs() < 1e-7, "seed {seed}: tracked {} != {}", s.cost(), exact);
+                    if moved {
+                        assert!(s.cost() < before, "seed {seed}: a move made the tour dearer");
+                    }
+                }
+            }
+            // A kick, then undo: the same tour again.
+            let mut rng = Rng(seed);
+            let (steps0, cost0) = (s.steps(), s.cost());
+            for _ in 0..20 {
+                s.journal.clear();
+                s.journaling = true;
+                if s.kick(&mut rng).is_some() {
+                    let steps = s.steps();
+                    assert!(feasible(&ends, &pairs, &steps), "seed {seed}: infeasible kick");
+                    assert!((route_cost(&ends, start, &steps) - s.cost()).abs() < 1e-7, "seed {seed}: kick cost");
+                }
+                s.undo_all(cost0);
+                assert_eq!(s.steps(), steps0, "seed {seed}: undo did not restore the tour");
+            }
+        }
+    }
+
+    #[test]
+    fn reaches_the_optimum_on_small_jobs() {
+        let mut missed = Vec::new();
+        for seed in 0..60u64 {
+            let n = if seed % 6 == 0 { 7 } else { 4 + (seed as usize % 3) };
+            let (ends, pairs, start) = job(seed + 1000, n, seed % 2 == 0, seed % 3 == 0);
+            let mut s = StrokeSearch::new(&ends, &pairs, start, &start_tour(n));
+            let stats = s.optimize(&Budget { deadline: None, kicks: Some(400), seed });
+            let steps = s.steps();
+            assert!(feasible(&ends, &pairs, &steps));
+            let got = route_cost(&ends, start, &steps);
+            assert!((got - stats.cost).abs() < 1e-7);
+            let opt = brute(&ends, &pairs, start);
+            assert!(got >= opt - 1e-7, "seed {seed}: below the optimum?");
+            if got > opt + 1e-7 {
+                missed.push((seed, got, opt));
+            }
+        }
+        assert!(missed.is_empty(), "not optimal: {missed:?}");
+    }
+
+    #[test]
+    fn same_budget_same_answer() {
+        let (ends, pairs, start) = job(5, 300, false, false);
+        let run = || {
+            let mut s = StrokeSearch::new(&ends, &pairs, start, &start_tour(300));
+            s.optimize(&Budget { deadline: None, kicks: Some(2000), seed: 9 });
+            s.steps()
+        };
+        assert_eq!(run(), run());
+    }
+
+    #[test]
+    fn improves_random_strokes_well_below_the_input_order() {
+        // 2-opt and Or-opt on 400 random strokes: far below the random input order.
+        let (ends, pairs, start) = job(11, 400, false, false);
+        let mut s = StrokeSearch::new(&ends, &pairs, start, &start_tour(400));
+        let stats = s.optimize(&Budget { deadline: None, kicks: Some(3000), seed: 1 });
+        assert!(stats.descent_cost < 0.5 * stats.start_cost, "{stats:?}");
+        assert!(stats.cost <= stats.descent_cost);
+        assert!((route_cost(&ends, start, &s.steps()) - stats.cost).abs() < 1e-6);
+    }
 }
