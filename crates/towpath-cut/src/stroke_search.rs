@@ -31,7 +31,7 @@ use std::time::Instant;
 use rstar::primitives::GeomWithData;
 use rstar::RTree;
 
-use crate::geom::{dist, P2};
+use crate::geom::P2;
 
 /// Pieces each piece keeps as near neighbours.
 const NEIGHBOURS: usize = 8;
@@ -118,8 +118,8 @@ pub struct StrokeSearch<'a> {
     deadline: Option<Instant>,
     cut: bool,
     moves: u64,
-    /// Longest stretch a move may reverse or pass without `free` (where a reversal cannot
-    /// go the short way round): bounds the work of a move on very large tours.
+    /// Longest stretch a move may reverse or pass (with `free`, on the shorter side): bounds
+    /// the work of a move on very large tours (none on up to about 17,000 pieces).
     span: usize,
 }
 
@@ -207,7 +207,7 @@ impl<'a> StrokeSearch<'a> {
             deadline: None,
             cut: false,
             moves: 0,
-            span: (50_000_000 / n.max(1)).max(1000),
+            span: (300_000_000 / n.max(1)).max(1000),
         };
         s.cost = s.full_cost();
         s
@@ -464,7 +464,8 @@ impl<'a> StrokeSearch<'a> {
             let canrev = self.rev[v as usize][m as usize].is_some();
             let (e, x) = self.ends[v as usize][m as usize];
             for f in [false, true] {
-                if f && (!canrev || e == x) {
+                // A flip is only needed where no mode is the reverse already.
+                if f && (!canrev || e == x || self.rev[v as usize][m as usize] != Some(m)) {
                     continue;
                 }
                 let (e, x) = if f { (x, e) } else { (e, x) };
@@ -487,7 +488,8 @@ impl<'a> StrokeSearch<'a> {
     /// precedence pair inside it, and (without `free`) no depot in it.
     fn reversal_ok(&self, a: u32, b: u32) -> bool {
         if self.free {
-            return true;
+            let len = self.seg_len(a, b);
+            return len.min(self.big() - len) <= self.span;
         }
         if self.holds_depot(a, b) {
             return false;
@@ -613,7 +615,7 @@ impl<'a> StrokeSearch<'a> {
                                     let (e, x) = self.ends[v as usize][m as usize];
                                     let canrev = self.rev[v as usize][m as usize].is_some();
                                     for f in [false, true] {
-                                        if f && (!canrev || e == x) {
+                                        if f && (!canrev || e == x || self.rev[v as usize][m as usize] != Some(m)) {
                                             continue;
                                         }
                                         let (e, x) = if f { (x, e) } else { (e, x) };
@@ -660,7 +662,8 @@ impl<'a> StrokeSearch<'a> {
     /// and directions (checked on linear positions; with `free` there is nothing to check).
     fn move_ok(&self, s1: u32, sk: u32, c: u32, reversed: bool) -> bool {
         if self.free {
-            return true;
+            let (p, q, d) = (self.prev(s1), self.next(sk), self.next(c));
+            return self.seg_len(q, c).min(self.seg_len(d, p)) <= self.span;
         }
         let (lo, hi) = (self.pos[s1 as usize], self.pos[sk as usize]);
         let seg = lo..=hi;
@@ -832,7 +835,9 @@ impl<'a> StrokeSearch<'a> {
 #[inline]
 fn link(a: Option<P2>, b: Option<P2>) -> f64 {
     match (a, b) {
-        (Some(a), Some(b)) => dist(a, b),
+        // Plain sqrt of squares (`hypot` guards against overflow no drawing reaches, at
+        // several times the price).
+        (Some(a), Some(b)) => ((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1])).sqrt(),
         _ => 0.0,
     }
 }
