@@ -335,37 +335,35 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
             group.iter().map(|&i| prep.candidates[i].iter().map(|c| (c.entry, c.exit)).collect()).collect();
         let greedy_steps = greedy(&ends, &group_pairs, at);
         let greedy_ok = check(&problem, &greedy_steps).is_ok();
-        let (solved, solved_cost) = if opts.solver == SolverName::Towpath
-            && greedy_ok
-            && group.len() > opts.solve.exact_up_to
-        {
-            // towpath's solver on stroke tours: the stroke local search (2-opt, Or-opt and
-            // kicks with neighbour lists) from the nearest-neighbour start, anytime.
-            let init: Vec<(usize, u32)> = greedy_steps.iter().map(|s| (s.task.index(), s.mode)).collect();
-            let mut search = StrokeSearch::new(&ends, &group_pairs, at, &init);
-            let budget = Budget {
-                deadline: opts.solve.time_limit.map(|d| t0 + d),
-                kicks: opts.solve.iterations,
-                seed: opts.solve.seed,
+        let (solved, solved_cost) =
+            if opts.solver == SolverName::Towpath && greedy_ok && group.len() > opts.solve.exact_up_to {
+                // towpath's solver on stroke tours: the stroke local search (2-opt, Or-opt and
+                // kicks with neighbour lists) from the nearest-neighbour start, anytime.
+                let init: Vec<(usize, u32)> = greedy_steps.iter().map(|s| (s.task.index(), s.mode)).collect();
+                let mut search = StrokeSearch::new(&ends, &group_pairs, at, &init);
+                let budget = Budget {
+                    deadline: opts.solve.time_limit.map(|d| t0 + d),
+                    kicks: opts.solve.iterations,
+                    seed: opts.solve.seed,
+                };
+                let stats = search.optimize(&budget);
+                iterations += stats.kicks;
+                let steps: Vec<Step> =
+                    search.steps().into_iter().map(|(t, m)| Step { task: TaskId(t as u32), mode: m }).collect();
+                // The independent checker of towpath-seq vouches for the route and its cost.
+                let cost = check(&problem, &steps)
+                    .map_err(|e| CutError::Solver(format!("the stroke search gave an invalid route: {e}")))?;
+                (steps, cost)
+            } else {
+                let mut sopts = opts.solve.clone();
+                if greedy_ok {
+                    sopts.initial = Some(greedy_steps);
+                }
+                let report = solve_with(opts.solver, &problem, &sopts, &opts.params)
+                    .map_err(|e| CutError::Solver(e.to_string()))?;
+                iterations += report.iterations;
+                (report.solution.steps, report.solution.cost)
             };
-            let stats = search.optimize(&budget);
-            iterations += stats.kicks;
-            let steps: Vec<Step> =
-                search.steps().into_iter().map(|(t, m)| Step { task: TaskId(t as u32), mode: m }).collect();
-            // The independent checker of towpath-seq vouches for the route and its cost.
-            let cost = check(&problem, &steps)
-                .map_err(|e| CutError::Solver(format!("the stroke search gave an invalid route: {e}")))?;
-            (steps, cost)
-        } else {
-            let mut sopts = opts.solve.clone();
-            if greedy_ok {
-                sopts.initial = Some(greedy_steps);
-            }
-            let report = solve_with(opts.solver, &problem, &sopts, &opts.params)
-                .map_err(|e| CutError::Solver(e.to_string()))?;
-            iterations += report.iterations;
-            (report.solution.steps, report.solution.cost)
-        };
         solve_seconds += t0.elapsed().as_secs_f64();
         let steps = match initial_cost {
             Some(c) if c < solved_cost => initial,

@@ -127,7 +127,12 @@ impl<'a> StrokeSearch<'a> {
     /// A search over pieces with modes `ends[t]` (entry, exit), precedence `pairs` (before,
     /// after), the route starting at `start` (or at the first piece) and ending anywhere,
     /// starting from `initial` (every piece once, as (piece, mode)).
-    pub fn new(ends: &'a [Vec<(P2, P2)>], pairs: &[(usize, usize)], start: Option<P2>, initial: &[(usize, u32)]) -> Self {
+    pub fn new(
+        ends: &'a [Vec<(P2, P2)>],
+        pairs: &[(usize, usize)],
+        start: Option<P2>,
+        initial: &[(usize, u32)],
+    ) -> Self {
         let n = ends.len();
         let rev: Vec<Vec<Option<u32>>> = ends
             .iter()
@@ -145,7 +150,9 @@ impl<'a> StrokeSearch<'a> {
         // u32::MAX marks "its own reverse" (closed contours); resolved to the mode itself.
         let rev: Vec<Vec<Option<u32>>> = rev
             .into_iter()
-            .map(|ms| ms.into_iter().enumerate().map(|(m, r)| r.map(|r| if r == u32::MAX { m as u32 } else { r })).collect())
+            .map(|ms| {
+                ms.into_iter().enumerate().map(|(m, r)| r.map(|r| if r == u32::MAX { m as u32 } else { r })).collect()
+            })
             .collect();
         let mut succ = vec![Vec::new(); n];
         let mut pred = vec![Vec::new(); n];
@@ -182,7 +189,8 @@ impl<'a> StrokeSearch<'a> {
         for (i, &v) in seq.iter().enumerate() {
             pos[v as usize] = i;
         }
-        let typical = ends.iter().flatten().map(|&(e, x)| e[0].abs() + e[1].abs() + x[0].abs() + x[1].abs()).fold(0.0, f64::max);
+        let typical =
+            ends.iter().flatten().map(|&(e, x)| e[0].abs() + e[1].abs() + x[0].abs() + x[1].abs()).fold(0.0, f64::max);
         let mut s = StrokeSearch {
             ends,
             start,
@@ -355,8 +363,11 @@ impl<'a> StrokeSearch<'a> {
     /// direction). Without `free`, the segment must not hold the depot.
     fn reverse(&mut self, a: u32, b: u32) {
         let bg = self.big();
-        let (mut i, mut j) =
-            if self.orient { (self.pos[b as usize], self.pos[a as usize]) } else { (self.pos[a as usize], self.pos[b as usize]) };
+        let (mut i, mut j) = if self.orient {
+            (self.pos[b as usize], self.pos[a as usize])
+        } else {
+            (self.pos[a as usize], self.pos[b as usize])
+        };
         let len = (j + bg - i) % bg + 1;
         let mut toggled = false;
         if self.free && 2 * len > bg && len < bg {
@@ -523,7 +534,8 @@ impl<'a> StrokeSearch<'a> {
             // exit–exit: v, [next(v) .. c], next(c)
             let nc = self.next(c);
             if c != nv && nc != v && c != v {
-                let d = link(self.exit(v), self.rentry(c)) + link(self.rexit(nv), self.entry(nc)) - out_v - self.arc(c, nc);
+                let d =
+                    link(self.exit(v), self.rentry(c)) + link(self.rexit(nv), self.entry(nc)) - out_v - self.arc(c, nc);
                 let (a, b) = (nv, c);
                 let (a, b, d) = self.pick_side(a, b, d, v, nc);
                 if d < -self.eps && best.is_none_or(|x| d < x.0) {
@@ -534,7 +546,8 @@ impl<'a> StrokeSearch<'a> {
             // new arcs prev(v)→prev(c)' and v'→c.
             let pc = self.prev(c);
             if c != pv && pc != v && c != v {
-                let d = link(self.exit(pv), self.rentry(pc)) + link(self.rexit(v), self.entry(c)) - in_v - self.arc(pc, c);
+                let d =
+                    link(self.exit(pv), self.rentry(pc)) + link(self.rexit(v), self.entry(c)) - in_v - self.arc(pc, c);
                 let (a, b, d) = self.pick_side(v, pc, d, pv, c);
                 if d < -self.eps && best.is_none_or(|x| d < x.0) {
                     best = Some((d, a, b));
@@ -563,9 +576,8 @@ impl<'a> StrokeSearch<'a> {
         if q == self.depot() || p == self.depot() {
             return (a, b, f64::INFINITY);
         }
-        let d2 = link(self.exit(b), self.rentry(p)) + link(self.rexit(q), self.entry(a))
-            - self.arc(b, q)
-            - self.arc(p, a);
+        let d2 =
+            link(self.exit(b), self.rentry(p)) + link(self.rexit(q), self.entry(a)) - self.arc(b, q) - self.arc(p, a);
         (q, p, d2)
     }
 
