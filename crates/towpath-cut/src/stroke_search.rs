@@ -75,6 +75,10 @@ enum Op {
     State { v: u32, mode: u32, flipped: bool },
 }
 
+/// An Or-opt move: (delta, first and last piece of the segment, the piece it goes after,
+/// reversed, a single piece's new mode and direction).
+type OrMove = (f64, u32, u32, u32, bool, Option<(u32, bool)>);
+
 /// Small deterministic random numbers (SplitMix64).
 struct Rng(u64);
 
@@ -585,7 +589,7 @@ impl<'a> StrokeSearch<'a> {
     fn try_or_opt(&mut self, v: u32) -> bool {
         let dep = self.depot();
         // (delta, s1, sk, c, reversed, single mode/flip)
-        let mut best: Option<(f64, u32, u32, u32, bool, Option<(u32, bool)>)> = None;
+        let mut best: Option<OrMove> = None;
         for k in 1..=OR_SEGMENT {
             for forward in [true, false] {
                 if k == 1 && !forward {
@@ -791,7 +795,7 @@ impl<'a> StrokeSearch<'a> {
         }
         self.run();
         stats.descent_cost = self.cost;
-        let mut rng = Rng(budget.seed ^ 0x5EED_0F_C0FF_EE00);
+        let mut rng = Rng(budget.seed ^ 0x5EED_0FC0_FFEE_0000);
         let max_kicks = match (budget.kicks, budget.deadline) {
             (Some(k), _) => k,
             (None, Some(_)) => u64::MAX,
@@ -909,7 +913,9 @@ mod tests {
 
     /// A random job: open strokes (some not reversible), closed contours with several entry
     /// candidates, optional start and precedence pairs (from lower to higher index, so acyclic).
-    fn job(seed: u64, n: usize, start: bool, prec: bool) -> (Vec<Vec<(P2, P2)>>, Vec<(usize, usize)>, Option<P2>) {
+    type Job = (Vec<Vec<(P2, P2)>>, Vec<(usize, usize)>, Option<P2>);
+
+    fn job(seed: u64, n: usize, start: bool, prec: bool) -> Job {
         let mut rng = Rng(seed);
         let mut p = || [rng.below(1000) as f64 / 10.0, rng.below(1000) as f64 / 10.0];
         let mut ends = Vec::new();
