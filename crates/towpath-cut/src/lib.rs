@@ -11,6 +11,7 @@
 //! - [`model`]: [`Drawing`], [`Piece`], [`Placement`].
 //! - [`contain`]: containment precedence. [`lead`]: lead-ins on the scrap side.
 //! - [`order`](mod@order): the ordering problem on `towpath_seq`, entry refinement.
+//! - [`stroke_search`]: the local search for stroke tours (2-opt, Or-opt, kicks) the ordering uses.
 //! - [`verify`](mod@verify): the independent verifier of an ordering.
 //! - [`io`]: readers and writers (SVG, DXF, G-code, JSON).
 //! - [`mill`]: pocket offsetting into toolpath cells, linking per tool, G-code and drawings.
@@ -25,6 +26,7 @@ pub mod lead;
 pub mod mill;
 pub mod model;
 pub mod order;
+pub mod stroke_search;
 pub mod verify;
 
 pub use error::CutError;

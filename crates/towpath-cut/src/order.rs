@@ -12,6 +12,10 @@
 //! - **Precedence.** A piece inside a closed contour comes before it (module [`crate::contain`]);
 //!   explicit hierarchy pairs are added; operations are done in their listed order (each one a
 //!   problem of its own starting where the previous one ended) unless they are mixed.
+//! - **Search.** With towpath's solver, groups of more than a few pieces are solved by
+//!   [`crate::stroke_search`] (2-opt, Or-opt with reversal and mode choice, segment-swap kicks)
+//!   from a grid nearest-neighbour tour; small ones exactly by `towpath_seq`'s dynamic program.
+//!   Either answer passes `towpath_seq::check`.
 //! - **Refinement.** After the solve, each closed contour's entry is moved along the contour to
 //!   the point that is best between the exit before it and the entry after it, a few passes over
 //!   the route; a move is kept only when it shortens the travel.
@@ -28,6 +32,7 @@ use crate::error::CutError;
 use crate::geom::{dist, seg_flatten, Path, Place, P2};
 use crate::lead::{lead_in, LeadIn};
 use crate::model::{travel, Drawing, Placement};
+use crate::stroke_search::{Budget, StrokeSearch};
 
 /// Where a closed contour may be entered.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -329,17 +334,40 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
         let ends: Vec<Vec<(P2, P2)>> =
             group.iter().map(|&i| prep.candidates[i].iter().map(|c| (c.entry, c.exit)).collect()).collect();
         let greedy_steps = greedy(&ends, &group_pairs, at);
-        let mut sopts = opts.solve.clone();
-        if check(&problem, &greedy_steps).is_ok() {
-            sopts.initial = Some(greedy_steps);
-        }
-        let report =
-            solve_with(opts.solver, &problem, &sopts, &opts.params).map_err(|e| CutError::Solver(e.to_string()))?;
+        let greedy_ok = check(&problem, &greedy_steps).is_ok();
+        let (solved, solved_cost) =
+            if opts.solver == SolverName::Towpath && greedy_ok && group.len() > opts.solve.exact_up_to {
+                // towpath's solver on stroke tours: the stroke local search (2-opt, Or-opt and
+                // kicks with neighbour lists) from the nearest-neighbour start, anytime.
+                let init: Vec<(usize, u32)> = greedy_steps.iter().map(|s| (s.task.index(), s.mode)).collect();
+                let mut search = StrokeSearch::new(&ends, &group_pairs, at, &init);
+                let budget = Budget {
+                    deadline: opts.solve.time_limit.map(|d| t0 + d),
+                    kicks: opts.solve.iterations,
+                    seed: opts.solve.seed,
+                };
+                let stats = search.optimize(&budget);
+                iterations += stats.kicks;
+                let steps: Vec<Step> =
+                    search.steps().into_iter().map(|(t, m)| Step { task: TaskId(t as u32), mode: m }).collect();
+                // The independent checker of towpath-seq vouches for the route and its cost.
+                let cost = check(&problem, &steps)
+                    .map_err(|e| CutError::Solver(format!("the stroke search gave an invalid route: {e}")))?;
+                (steps, cost)
+            } else {
+                let mut sopts = opts.solve.clone();
+                if greedy_ok {
+                    sopts.initial = Some(greedy_steps);
+                }
+                let report = solve_with(opts.solver, &problem, &sopts, &opts.params)
+                    .map_err(|e| CutError::Solver(e.to_string()))?;
+                iterations += report.iterations;
+                (report.solution.steps, report.solution.cost)
+            };
         solve_seconds += t0.elapsed().as_secs_f64();
-        iterations += report.iterations;
         let steps = match initial_cost {
-            Some(c) if c < report.solution.cost => initial,
-            _ => report.solution.steps,
+            Some(c) if c < solved_cost => initial,
+            _ => solved,
         };
         for s in &steps {
             let i = group[s.task.index()];

@@ -108,7 +108,7 @@ pub struct Args {
     /// Flattening and "touching" tolerance in drawing units.
     #[arg(long, default_value_t = 1e-3)]
     pub tolerance: f64,
-    /// Solver time limit in seconds (default 1 + 0.0003 s per piece, at most 8).
+    /// Solver time limit in seconds (default 0.2 ms per piece, at least 0.1 s and at most 5 s).
     #[arg(long)]
     pub time_limit: Option<f64>,
     /// Work budget (improvement kicks); without --time-limit the answer then depends only on
@@ -182,7 +182,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let time_limit = match (args.time_limit, args.iterations) {
         (Some(t), _) => Some(crate::cmd::solver_args::time_limit(t)?),
         (None, Some(_)) => None,
-        (None, None) => Some(std::time::Duration::from_secs_f64((1.0 + 0.0003 * n as f64).min(8.0))),
+        (None, None) => Some(std::time::Duration::from_secs_f64((0.0002 * n as f64).clamp(0.1, 5.0))),
     };
     let mut solve =
         SolveOptions { time_limit, iterations: args.iterations, seed: args.seed, ..SolveOptions::default() };
