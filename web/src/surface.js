@@ -39,8 +39,21 @@ function request() {
 function value(c, i, mode) {
   if (mode === 'angle') return c.angle_deviation_deg[i] ?? 0;
   if (mode === 'radius') return c.steering_radius[i];
-  const g = c.gap_to_left[i];
-  return g ? g[1] - g[0] : 0; // overlap positive, gap negative
+  return -gapNear(c.gap_to_left, c.arc_length ? c.arc_length[i] : 0); // overlap positive, gap negative
+}
+
+// The gap (+) or overlap (−) width of the sample nearest arc length `s`: `gaps` holds
+// (arc length, width) pairs sampled along the course, not one per point.
+function gapNear(gaps, s) {
+  if (!gaps || gaps.length === 0) return 0;
+  let lo = 0;
+  let hi = gaps.length - 1;
+  while (lo < hi) {
+    const mid = (lo + hi) >> 1;
+    if (gaps[mid][0] < s) lo = mid + 1; else hi = mid;
+  }
+  const k = lo > 0 && Math.abs(gaps[lo - 1][0] - s) < Math.abs(gaps[lo][0] - s) ? lo - 1 : lo;
+  return gaps[k][1];
 }
 
 function colorFor(v, mode, range) {

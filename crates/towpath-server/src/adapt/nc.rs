@@ -235,7 +235,8 @@ impl Parsed {
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct OptimizeRequest {
-    /// Cost model: `axis`, `time` or `tool`.
+    /// Cost model: `auto` (cycle time when every axis of the machine has a velocity, else the
+    /// weighted axis distance, as `towpath optimize` chooses), `axis`, `time` or `tool`.
     pub cost: String,
     /// Allow reversed courses.
     pub bidirectional: bool,
@@ -262,7 +263,7 @@ pub struct OptimizeRequest {
 impl Default for OptimizeRequest {
     fn default() -> Self {
         OptimizeRequest {
-            cost: "axis".into(),
+            cost: "auto".into(),
             bidirectional: false,
             precedence: "courses".into(),
             keep_ply_order: false,
@@ -284,7 +285,11 @@ struct Checked {
 
 impl OptimizeRequest {
     fn check(&self) -> Result<Checked, ApiError> {
-        let cost: CostKind = self.cost.parse().map_err(|e: String| ApiError::bad(format!("cost: {e}")))?;
+        // `auto` is resolved against the machine in `optimize`; the time cost stands in until then.
+        let cost: CostKind = match self.cost.as_str() {
+            "auto" => CostKind::Time,
+            c => c.parse().map_err(|e: String| ApiError::bad(format!("cost: {e}")))?,
+        };
         let precedence: PrecedenceRule =
             self.precedence.parse().map_err(|e: String| ApiError::bad(format!("precedence: {e}")))?;
         let solver: SolverName = self.solver.parse().map_err(|e| ApiError::bad(format!("solver: {e}")))?;
@@ -435,7 +440,10 @@ pub fn optimize(
     req: &OptimizeRequest,
     hooks: &Hooks,
 ) -> Result<OptimizeOutcome, Stopped> {
-    let checked = req.check()?;
+    let mut checked = req.check()?;
+    if req.cost == "auto" {
+        checked.afp.cost = towpath_nc::default_cost(machine);
+    }
     let cancelled = || hooks.cancel.load(Ordering::Relaxed);
     let t0 = Instant::now();
     (hooks.phase)("parsing");
