@@ -137,6 +137,66 @@ pub struct Machine {
     /// The tool point in the last DH frame (default `[0, 0, 0]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tool_offset: Option<[f64; 3]>,
+    /// A simple model of the head for motion-safety checks (optional `[head]` table).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub head: Option<Head>,
+}
+
+/// A simple model of the head (the roller and compaction unit, the cutter housing), the
+/// optional `[head]` table of a machine file: a capsule whose axis runs along the tool axis,
+/// away from the part, from `bottom` to `top` mm above the tool point, with radius `radius`.
+/// Motion-safety checks test it like the tool point, with the same clearance
+/// (`docs/motion.md`).
+///
+/// ```toml
+/// [head]
+/// radius = 40.0   # mm
+/// bottom = 45.0   # mm above the tool point, along the tool axis (at least the radius)
+/// top = 300.0     # mm
+/// ```
+///
+/// A cylinder of radius r from height h0 to h1 lies inside the capsule with the same radius
+/// and axis from h0 to h1, so describing a cylindrical head that way is safe (by up to r too
+/// cautious at its two ends).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Head {
+    /// Radius of the capsule, mm (> 0).
+    pub radius: f64,
+    /// Height of the lower end of the capsule's axis above the tool point, mm (≥ `radius`, so
+    /// that the head never reaches below the tool point: a flat surface under the tool does not
+    /// touch it).
+    pub bottom: f64,
+    /// Height of the upper end of the capsule's axis above the tool point, mm (≥ `bottom`).
+    pub top: f64,
+}
+
+impl Head {
+    /// Checks every value; a refused value is named as `head.radius` etc.
+    pub fn validate(&self) -> Result<(), MachineError> {
+        let bad = |key: &str, message: String| Err(invalid(format!("head.{key}"), message));
+        for (k, v) in [("radius", self.radius), ("bottom", self.bottom), ("top", self.top)] {
+            if !v.is_finite() || v.abs() > MAX_AXIS_VALUE {
+                return bad(k, format!("{v} is not a finite number of at most {MAX_AXIS_VALUE} mm"));
+            }
+        }
+        if self.radius <= 0.0 {
+            return bad("radius", format!("{} is not a radius > 0", self.radius));
+        }
+        if self.bottom < self.radius {
+            return bad(
+                "bottom",
+                format!(
+                    "{} is below the radius {}: the head would reach below the tool point and touch the part at every contact",
+                    self.bottom, self.radius
+                ),
+            );
+        }
+        if self.top < self.bottom {
+            return bad("top", format!("{} is below bottom {}", self.top, self.bottom));
+        }
+        Ok(())
+    }
 }
 
 /// Why a machine file was refused.
@@ -193,7 +253,7 @@ pub const MAX_AXES: usize = 64;
 impl Machine {
     /// A machine with the given axes and no kinematics.
     pub fn new(name: &str, axes: Vec<Axis>) -> Result<Self, MachineError> {
-        let m = Machine { name: name.to_string(), axes, dh: Vec::new(), tool_offset: None };
+        let m = Machine { name: name.to_string(), axes, dh: Vec::new(), tool_offset: None, head: None };
         m.validate()?;
         Ok(m)
     }
@@ -222,6 +282,9 @@ impl Machine {
 
     /// Checks every value; called by the constructors.
     pub fn validate(&self) -> Result<(), MachineError> {
+        if let Some(h) = &self.head {
+            h.validate()?;
+        }
         if self.axes.is_empty() {
             return Err(invalid("axis", "the machine has no axes"));
         }
@@ -448,6 +511,27 @@ label = "C"
 kind = "continuous"
 heading = true
 "#;
+
+    #[test]
+    fn head_table_is_read_and_checked() {
+        let base = "name = \"g\"\n[[axis]]\nlabel = \"X\"\nkind = \"linear\"\n";
+        let m = Machine::from_toml_str(&format!("{base}[head]\nradius = 40.0\nbottom = 45.0\ntop = 300.0\n")).unwrap();
+        assert_eq!(m.head, Some(Head { radius: 40.0, bottom: 45.0, top: 300.0 }));
+        let e =
+            Machine::from_toml_str(&format!("{base}[head]\nradius = 40.0\nbottom = 10.0\ntop = 300.0\n")).unwrap_err();
+        assert_eq!(e.to_string().split(':').take(2).collect::<Vec<_>>(), ["line 7", " head.bottom"], "{e}");
+        assert!(Machine::from_toml_str(&format!(
+            "{base}[head]\nradius = 40.0\nbottom = 45.0\ntop = 300.0\nlength = 2\n"
+        ))
+        .is_err());
+        for bad in [
+            "radius = 0.0\nbottom = 1.0\ntop = 2.0",
+            "radius = 1.0\nbottom = 10.0\ntop = 5.0",
+            "radius = 1.0\nbottom = nan\ntop = 5.0",
+        ] {
+            assert!(Machine::from_toml_str(&format!("{base}[head]\n{bad}\n")).is_err(), "{bad}");
+        }
+    }
 
     #[test]
     fn reads_the_documented_shape() {

@@ -30,7 +30,7 @@ mod locate;
 mod motion;
 
 pub use config::{
-    Axis, AxisKind, DhJoint, Machine, MachineError, ACCELERATION_RANGE, MAX_AXES, MAX_AXIS_VALUE, MAX_DH_ANGLE,
+    Axis, AxisKind, DhJoint, Head, Machine, MachineError, ACCELERATION_RANGE, MAX_AXES, MAX_AXIS_VALUE, MAX_DH_ANGLE,
     MAX_WEIGHT, VELOCITY_RANGE,
 };
 pub use cost::{CostError, CostKind, MachineCost, StateTable};

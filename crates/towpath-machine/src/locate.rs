@@ -38,8 +38,14 @@ pub(crate) fn line_of(text: &str, key: &str) -> usize {
             }
             continue;
         }
-        if line.starts_with('[') {
-            current = Some((line.to_string(), usize::MAX));
+        if let Some(name) = line.strip_prefix('[').and_then(|l| l.strip_suffix(']')) {
+            // A plain table (`[head]`): index usize::MAX, as `split` gives for `head.radius`.
+            current = Some((unquote(name.trim()).to_string(), usize::MAX));
+            if let Some((t, usize::MAX)) = &table {
+                if *t == unquote(name.trim()) {
+                    header_line = i + 1;
+                }
+            }
             continue;
         }
         let Some((k, _)) = line.split_once('=') else { continue };
@@ -73,7 +79,9 @@ fn split(key: &str) -> (Option<(String, usize)>, Option<&str>) {
             (Some((name.to_string(), index)), field)
         }
         None if field.is_none() && (head == "axis" || head == "dh") => (Some((head.to_string(), 0)), None),
-        None => (None, Some(head)),
+        None if field.is_none() => (None, Some(head)),
+        // A key of a plain table (`head.radius`).
+        None => (Some((head.to_string(), usize::MAX)), field),
     }
 }
 
@@ -111,6 +119,9 @@ mod tests {
         assert_eq!(line_of(text, "dh[1].alpha"), 13);
         assert_eq!(line_of(text, "dh[1]"), 12);
         assert_eq!(line_of(text, "axis"), 4);
+        let with_head = "name = \"m\"\n[head]\nradius = 4\n\nbottom = 1\n[[axis]]\nlabel = \"X\"\n";
+        assert_eq!(line_of(with_head, "head.bottom"), 5);
+        assert_eq!(line_of(with_head, "head.top"), 2);
         // Not there at all.
         assert_eq!(line_of(text, "axis[5].weight"), 0);
         assert_eq!(line_of("axis = [{ label = \"X\", kind = \"linear\" }]", "axis[0].kind"), 0);

@@ -16,19 +16,6 @@ pub enum CellError {
     },
 }
 
-/// A head model that cannot be used.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum HeadError {
-    /// A key of the head has a bad value; `key` names it (`head.radius`).
-    #[error("{key}: {message}")]
-    Invalid {
-        /// The key.
-        key: String,
-        /// What is wrong.
-        message: String,
-    },
-}
-
 /// A set-up that would make the checks meaningless, refused before any move is checked.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SetupError {
@@ -99,7 +86,7 @@ pub enum SetupError {
     NoKinematics,
     /// The head model is invalid.
     #[error(transparent)]
-    Head(#[from] HeadError),
+    Head(#[from] towpath_machine::MachineError),
 }
 
 fn fmt_limit(v: Option<f64>) -> String {

@@ -7,7 +7,7 @@
 //! - [`Cell`]: the obstacle meshes, in the part frame (which turns with the mandrel), merged
 //!   under one bounding volume hierarchy (parry's [`parry3d_f64::partitioning::Bvh`]).
 //! - [`Rig`]: the machine's kinematics ([`towpath_machine::Kinematics`]) with an optional
-//!   [`Head`] (a capsule along the tool axis, the future `[head]` table of the machine file):
+//!   [`Head`] (a capsule along the tool axis, the `[head]` table of the machine file):
 //!   the tool point and head axis in the part frame for an axis state, and a bound on how
 //!   sharply a move's path bends ([`Rig::bend_bound`]).
 //! - [`Checker`]: checks one move (all axes interpolated linearly together, wrapping axes the
@@ -45,8 +45,8 @@ mod setup;
 pub use cell::Cell;
 pub use check::{Body, CheckOptions, Checker, Contact, LimitViolation, MoveCheck};
 pub use cost::TransitCost;
-pub use error::{CellError, HeadError, PlanError, SetupError};
-pub use head::Head;
+pub use error::{CellError, PlanError, SetupError};
 pub use plan::{LiftRule, PlanOptions, Planner, Transit};
 pub use rig::{Pose, Rig};
 pub use setup::{check_laid_points, check_mandrel_radius, check_states};
+pub use towpath_machine::Head;

@@ -3,10 +3,9 @@
 //! the axes, and how sharply the path of any point of the head can bend during a move.
 
 use towpath_geom::DVec3;
-use towpath_machine::{AxisKind, Kinematics, Machine};
+use towpath_machine::{AxisKind, Head, Kinematics, Machine};
 
 use crate::error::SetupError;
-use crate::head::Head;
 
 /// Where the tool is for one axis state, in the part frame.
 #[derive(Clone, Copy, Debug, PartialEq)]

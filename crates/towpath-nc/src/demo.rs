@@ -76,6 +76,7 @@ pub fn gantry() -> Machine {
         ],
         dh: Vec::new(),
         tool_offset: None,
+        head: None,
     }
 }
 
@@ -95,6 +96,7 @@ pub fn mandrel_machine() -> Machine {
         ],
         dh: Vec::new(),
         tool_offset: None,
+        head: None,
     }
 }
 
