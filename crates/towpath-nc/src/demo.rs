@@ -52,6 +52,65 @@ pub struct DemoPart {
     pub machine: Machine,
     /// The program text.
     pub program: String,
+    /// The cell for motion safety: the mold tool, stringers, fixtures (empty for the parts
+    /// without obstacles).
+    pub obstacles: Vec<Obstacle>,
+}
+
+/// One mesh of a demo part's cell, in the part frame (mm).
+#[derive(Clone, Debug)]
+pub struct Obstacle {
+    /// File-friendly name (`tool`, `stringer`, `clamp`, `flange`).
+    pub name: String,
+    /// The triangles.
+    pub triangles: Vec<[[f64; 3]; 3]>,
+}
+
+/// An axis-aligned box `[x0, y0, z0]`–`[x1, y1, z1]` as 12 triangles.
+pub fn box_mesh(lo: [f64; 3], hi: [f64; 3]) -> Vec<[[f64; 3]; 3]> {
+    let c = |i: usize| {
+        [
+            if i & 1 == 0 { lo[0] } else { hi[0] },
+            if i & 2 == 0 { lo[1] } else { hi[1] },
+            if i & 4 == 0 { lo[2] } else { hi[2] },
+        ]
+    };
+    // Each face as a quad of corner indices (bit 0: x, bit 1: y, bit 2: z).
+    let faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    faces.iter().flat_map(|f| [[c(f[0]), c(f[1]), c(f[2])], [c(f[0]), c(f[2]), c(f[3])]]).collect()
+}
+
+/// A flat rectangle at height `z` as 2 triangles.
+pub fn plate_mesh(x: [f64; 2], y: [f64; 2], z: f64) -> Vec<[[f64; 3]; 3]> {
+    let p = |i: usize, j: usize| [x[i], y[j], z];
+    vec![[p(0, 0), p(1, 0), p(1, 1)], [p(0, 0), p(1, 1), p(0, 1)]]
+}
+
+/// A cylinder about the X axis: radius `r` from `x0` to `x1`, `n` facets round, each facet's
+/// edges on the radius (so the facets lie just inside it).
+pub fn cylinder_mesh(r: f64, x0: f64, x1: f64, n: usize) -> Vec<[[f64; 3]; 3]> {
+    let at = |x: f64, k: usize| {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        [x, r * a.cos(), r * a.sin()]
+    };
+    (0..n).flat_map(|k| [[at(x0, k), at(x1, k), at(x1, k + 1)], [at(x0, k), at(x1, k + 1), at(x0, k + 1)]]).collect()
+}
+
+/// A flange about the X axis: a ring from radius `r0` to `r1`, between `x0` and `x1`, `n`
+/// facets round (both faces and the outer rim).
+pub fn flange_mesh(r0: f64, r1: f64, x0: f64, x1: f64, n: usize) -> Vec<[[f64; 3]; 3]> {
+    let at = |x: f64, r: f64, k: usize| {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        [x, r * a.cos(), r * a.sin()]
+    };
+    let mut t = cylinder_mesh(r1, x0, x1, n);
+    for x in [x0, x1] {
+        for k in 0..n {
+            t.push([at(x, r0, k), at(x, r1, k), at(x, r1, k + 1)]);
+            t.push([at(x, r0, k), at(x, r1, k + 1), at(x, r0, k + 1)]);
+        }
+    }
+    t
 }
 
 fn axis(label: &str, kind: AxisKind, weight: f64, v: f64, a: f64) -> Axis {
@@ -270,7 +329,9 @@ pub fn demo_parts() -> Vec<DemoPart> {
         seed,
         machine: machine.clone(),
         program: program(name, surface, &plies),
+        obstacles: Vec::new(),
     };
+    let obstacle = |name: &str, triangles| Obstacle { name: name.into(), triangles };
     vec![
         part(
             "planar-0",
@@ -333,6 +394,45 @@ pub fn demo_parts() -> Vec<DemoPart> {
                 ply("pad-up 45 deg", [1200.0, 1400.0, 1800.0, 2100.0], 45.0),
             ],
         ),
+        // Parts in a cell (motion safety, docs/motion.md): the program's transits at the
+        // 25 mm standoff run straight through the obstacles, so the input collides.
+        DemoPart {
+            obstacles: vec![
+                obstacle("tool", plate_mesh([-100.0, 1300.0], [-100.0, 900.0], 0.0)),
+                obstacle("stringer", box_mesh([575.0, -100.0, 0.0], [625.0, 900.0, 60.0])),
+                obstacle("clamp", box_mesh([-70.0, 370.0, 0.0], [-15.0, 430.0, 50.0])),
+            ],
+            ..part(
+                "planar-stringer",
+                "planar tool with a 60 mm stringer across it and a clamp, two skins and two pad-ups",
+                None,
+                &g,
+                Surface::Plane,
+                vec![
+                    ply("left skin", [0.0, 0.0, 550.0, 800.0], 0.0),
+                    ply("right skin", [650.0, 0.0, 1200.0, 800.0], 0.0),
+                    ply("pad-up right", [700.0, 300.0, 1000.0, 500.0], 90.0),
+                    ply("pad-up left", [100.0, 300.0, 400.0, 500.0], 90.0),
+                ],
+            )
+        },
+        DemoPart {
+            obstacles: vec![
+                obstacle("mandrel", cylinder_mesh(r, -100.0, 3100.0, 256)),
+                obstacle("flange", flange_mesh(380.0, 470.0, 1490.0, 1510.0, 256)),
+            ],
+            ..part(
+                "cylinder-flange",
+                "mandrel with a 70 mm flange between two bands",
+                None,
+                &m,
+                Surface::Cylinder(r),
+                vec![
+                    ply("left band", [0.0, 0.0, 1400.0, circ], 0.0),
+                    ply("right band", [1600.0, 0.0, 3000.0, circ], 0.0),
+                ],
+            )
+        },
     ]
 }
 

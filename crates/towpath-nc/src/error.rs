@@ -24,6 +24,10 @@ pub enum NcError {
         /// What is wrong.
         message: String,
     },
+    /// A program towpath would write does not pass the motion-safety checks (a collision with
+    /// the cell or an axis outside its travel limits), so it is not written.
+    #[error("motion safety: {0}")]
+    Unsafe(String),
     /// The dialect file or settings are wrong.
     #[error("dialect: {0}")]
     Dialect(String),

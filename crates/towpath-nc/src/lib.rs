@@ -22,6 +22,7 @@ mod program;
 mod report;
 mod reverse;
 mod rewrite;
+mod safety;
 mod sequencer;
 mod verify;
 mod verify_lines;
@@ -35,16 +36,22 @@ pub use footprint::{
 pub use interp::{Event, Interp, Marker, Modal};
 pub use lex::{lex, LexIssue, Lexed, NumText, Word};
 pub use optimize::{
-    apply_steps, auto_time_limit, fallback_reason, optimize, Fallback, OptimizeOptions, Optimized, SolverSummary,
-    Timings,
+    apply_steps, auto_time_limit, fallback_reason, optimize, Fallback, OptimizeOptions, Optimized, SafetyPair,
+    SolverSummary, Timings,
 };
 pub use parse::parse;
 pub use precedence::{course_precedence, precedence_sets, MAX_VISITS};
-pub use problem::{build_problem, default_cost, placements, AfpOptions, AfpProblem, PrecedenceRule};
+pub use problem::{
+    build_problem, build_problem_with, default_cost, placements, AfpCost, AfpOptions, AfpProblem, PrecedenceRule,
+};
 pub use program::{ply_name, Course, Item, LineBreak, Ply, Program, Region, Segment, SwitchKey};
 pub use report::{cost_words, headline, totals, totals_table, GroupCost, GroupRow, OrderRow, Report, Totals};
 pub use reverse::{reversal_of, reverse_course, Irreversible, Reversed};
-pub use rewrite::{rewrite, Placement};
+pub use rewrite::{rewrite, rewrite_with, Placement};
+pub use safety::{
+    check_cell_under_path, check_program, limit_violations, LimitIssue, MoveIssue, Safety, SafetyOptions, SafetyReport,
+    DEFAULT_CLEARANCE, MOLD_GAP,
+};
 pub use sequencer::{seed000_sets, sequence};
 pub use towpath_baselines::{BaselineParams, SolverName};
 pub use verify::{measure, verify, verify_parsed, Motion, Verification, VerifyError, VerifyOptions};

@@ -9,9 +9,10 @@ use towpath_seq::{check, SolveOptions, Step};
 
 use crate::dialect::Dialect;
 use crate::error::NcError;
-use crate::problem::{build_problem, placements, AfpOptions, AfpProblem};
+use crate::problem::{build_problem_with, placements, AfpOptions, AfpProblem};
 use crate::program::Program;
-use crate::rewrite::{rewrite, Placement};
+use crate::rewrite::{rewrite, rewrite_with, Placement};
+use crate::safety::{check_cell_under_path, check_program, limit_violations, Safety, SafetyReport, MOLD_GAP};
 use crate::sequencer::sequence;
 use crate::verify::{verify_parsed, Verification, VerifyOptions};
 
@@ -35,6 +36,10 @@ pub struct OptimizeOptions {
     /// Parameters of the published solvers (docs/references.md). `doherty` without `sets` gets the program's
     /// Doherty et al.'s precedence sets ([`crate::seed000_sets`]).
     pub baselines: BaselineParams,
+    /// The cell and clearance: with it, transits are planned against the cell (priced so by the
+    /// sequencer and written so), and the output is refused unless it is free of collisions
+    /// and limit violations.
+    pub safety: Option<Safety>,
 }
 
 impl Default for OptimizeOptions {
@@ -48,6 +53,7 @@ impl Default for OptimizeOptions {
             progress: None,
             solver: SolverName::Towpath,
             baselines: BaselineParams::default(),
+            safety: None,
         }
     }
 }
@@ -68,8 +74,18 @@ impl std::fmt::Debug for OptimizeOptions {
             .field("threads", &self.threads)
             .field("solver", &self.solver)
             .field("baselines", &self.baselines)
+            .field("safety", &self.safety.as_ref().map(|s| s.clearance()))
             .finish()
     }
+}
+
+/// The motion safety of a program before and after optimization.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SafetyPair {
+    /// The input program.
+    pub before: SafetyReport,
+    /// The program written.
+    pub after: SafetyReport,
 }
 
 /// Wall time of each stage, in seconds.
@@ -126,6 +142,8 @@ pub struct Optimized {
     pub fell_back: bool,
     /// Why the input was returned unchanged (when [`Optimized::fell_back`]).
     pub fallback: Option<Fallback>,
+    /// The motion safety of the input and of the output, when a cell was given.
+    pub safety: Option<SafetyPair>,
     /// The course width used and where it came from (with a warning if the width given
     /// disagrees with the dialect's).
     pub width: crate::width::WidthUsed,
@@ -148,7 +166,15 @@ pub fn optimize(
     let width = crate::width::WidthUsed::choose(opts.afp.width, dialect, &program);
     let t_parse = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let afp = build_problem(&program, machine, dialect, &opts.afp)?;
+    let safety = opts.safety.as_ref();
+    let input_safety = match safety {
+        Some(sf) => {
+            check_cell_under_path(&program, machine, sf, MOLD_GAP)?;
+            Some(check_program(&program, sf))
+        }
+        None => None,
+    };
+    let afp = build_problem_with(&program, machine, dialect, &opts.afp, safety)?;
     let t_build = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
     let report = sequence(
@@ -162,11 +188,21 @@ pub fn optimize(
             iterations: opts.iterations,
             seed: opts.seed,
             threads: opts.threads.max(1),
-            initial: Some(afp.original.clone()),
+            // With a cell, the input order may hold a transit that cannot be made safe (no level
+            // within the travel limits clears): it is then no starting point.
+            initial: (safety.is_none() || check(&afp.problem, &afp.original).is_ok()).then(|| afp.original.clone()),
             progress: opts.progress.clone(),
             ..SolveOptions::default()
         },
-    )?;
+    )
+    .map_err(|e| match (safety, &e) {
+        (Some(sf), NcError::Sequencing(_) | NcError::Solver(_)) => NcError::Unsafe(format!(
+            "no order of the courses found whose every transit can be made safe (a clearance of {} mm within the \
+             travel limits): {e}",
+            sf.clearance()
+        )),
+        _ => e,
+    })?;
     let t_solve = t2.elapsed().as_secs_f64();
     let solver = SolverSummary {
         solver: opts.solver.to_string(),
@@ -177,7 +213,8 @@ pub fn optimize(
     };
     let t3 = Instant::now();
     let mut order = placements(&report.solution.steps);
-    let mut out = rewrite(&program, &order, machine, dialect, &afp.reversed)?;
+    let planner = safety.map(|s| s.planner().as_ref());
+    let mut out = rewrite_with(&program, &order, machine, dialect, &afp.reversed, planner)?;
     let t_rewrite = t3.elapsed().as_secs_f64();
     let t4 = Instant::now();
     let vopts = VerifyOptions {
@@ -192,12 +229,57 @@ pub fn optimize(
             .map_err(|e| NcError::SelfCheck(e.to_string()))
     };
     let mut verification = check(&out)?;
-    let fallback = fallback_reason(&verification, opts.afp.cost);
-    if fallback.is_some() {
-        order = (0..program.courses.len()).map(|c| Placement { course: c, reversed: false }).collect();
-        out = text.to_string();
-        verification = check(&out)?;
+    let identity: Vec<Placement> =
+        (0..program.courses.len()).map(|c| Placement { course: c, reversed: false }).collect();
+    let mut fallback = fallback_reason(&verification, opts.afp.cost);
+    match (&input_safety, planner) {
+        (Some(before), Some(planner)) if !before.is_safe() => {
+            // The input itself is unsafe, so it is no fallback: the solver's order is compared
+            // with the input order written with safe transits, and the better one is kept.
+            let safe_input = rewrite_with(&program, &identity, machine, dialect, &afp.reversed, Some(planner))?;
+            let v = check(&safe_input)?;
+            fallback = worse_than(&verification, &v, opts.afp.cost);
+            if fallback.is_some() {
+                order = identity;
+                out = safe_input;
+                verification = v;
+            }
+        }
+        _ if fallback.is_some() => {
+            order = identity;
+            out = text.to_string();
+            verification = check(&out)?;
+        }
+        _ => {}
     }
+    let safety = match (safety, input_safety) {
+        (Some(sf), Some(before)) => {
+            let parsed = crate::parse::parse(&out, machine, dialect).map_err(|e| NcError::SelfCheck(e.to_string()))?;
+            let after = check_program(&parsed, sf);
+            if !after.is_safe() {
+                let mut why = vec![format!("the program towpath would write has {}", after.summary())];
+                if !before.is_safe() {
+                    why.push(format!("the input has {}", before.summary()));
+                }
+                why.extend(after.details(5));
+                return Err(NcError::Unsafe(why.join("\n")));
+            }
+            Some(SafetyPair { before, after })
+        }
+        _ => {
+            // Without a cell, the travel limits are still checked on what is written.
+            let parsed = crate::parse::parse(&out, machine, dialect).map_err(|e| NcError::SelfCheck(e.to_string()))?;
+            let outside = limit_violations(&parsed, machine);
+            if !outside.is_empty() && limit_violations(&program, machine).is_empty() {
+                let report = SafetyReport { limit_violations: outside, ..SafetyReport::default() };
+                return Err(NcError::Unsafe(format!(
+                    "the program towpath would write leaves the travel limits:\n{}",
+                    report.details(5).join("\n")
+                )));
+            }
+            None
+        }
+    };
     let t_verify = t4.elapsed().as_secs_f64();
     Ok(Optimized {
         text: out,
@@ -217,6 +299,7 @@ pub fn optimize(
         fell_back: fallback.is_some(),
         fallback,
         width,
+        safety,
     })
 }
 
@@ -237,6 +320,19 @@ pub fn fallback_reason(v: &Verification, cost: CostKind) -> Option<Fallback> {
         before: before.off_part(),
         after: after.off_part(),
     })
+}
+
+/// Why `cand` (a written program's verification) is worse than `base` (another written
+/// order of the same input): a longer cycle time, or more off-part motion under `cost`.
+fn worse_than(cand: &Verification, base: &Verification, cost: CostKind) -> Option<Fallback> {
+    let worse = |b: f64, a: f64| a > b * (1.0 + 1e-12) + 1e-9;
+    if let (Some((_, a)), Some((_, b))) = (cand.motion(CostKind::Time), base.motion(CostKind::Time)) {
+        if worse(b.total(), a.total()) {
+            return Some(Fallback::CycleTime { before: b.total(), after: a.total() });
+        }
+    }
+    let ((_, a), (_, b)) = (cand.motion(cost)?, base.motion(cost)?);
+    worse(b.off_part(), a.off_part()).then(|| Fallback::Cost { kind: cost, before: b.off_part(), after: a.off_part() })
 }
 
 /// Why [`optimize`] returned the input unchanged.

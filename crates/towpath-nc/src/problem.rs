@@ -8,8 +8,11 @@
 //! so the route cost is the off-part motion of the courses. The route starts at the end of the
 //! header and ends free, or at the footer's end state when the footer writes every axis.
 
+use std::sync::Arc;
+
 use towpath_machine::{CostKind, Machine, MachineCost, StateTable};
-use towpath_seq::{End, Mode, Problem, Step, TaskId};
+use towpath_motion::TransitCost;
+use towpath_seq::{Cost, CostModel, End, Mode, Problem, StateId, Step, TaskId};
 
 use crate::dialect::Dialect;
 use crate::error::NcError;
@@ -18,6 +21,51 @@ use crate::interp::Interp;
 use crate::precedence::{course_precedence, precedence_sets};
 use crate::program::Program;
 use crate::reverse::{reversal_of, Irreversible, Reversed};
+use crate::safety::Safety;
+
+/// The cost of a transit between courses, as the rewriter will write it.
+#[derive(Clone, Debug)]
+pub enum AfpCost {
+    /// One direct move (or up to the dialect's fixed clearance, across and down), priced by
+    /// the machine's cost model.
+    Direct(MachineCost),
+    /// The transit the motion-safety planner plans against the cell (straight where that keeps
+    /// the clearance, else lifted only as high as the obstacles need), each move priced by the
+    /// machine's cost model; arcs with no safe transit are forbidden.
+    Planned(Arc<TransitCost>),
+}
+
+impl AfpCost {
+    /// The machine's cost model and the states.
+    pub fn machine_cost(&self) -> &MachineCost {
+        match self {
+            AfpCost::Direct(c) => c,
+            AfpCost::Planned(t) => t.base(),
+        }
+    }
+}
+
+impl CostModel for AfpCost {
+    fn num_states(&self) -> usize {
+        self.machine_cost().num_states()
+    }
+
+    #[inline]
+    fn cost(&self, from: StateId, to: StateId) -> Cost {
+        match self {
+            AfpCost::Direct(c) => c.cost(from, to),
+            AfpCost::Planned(t) => t.cost(from, to),
+        }
+    }
+
+    fn is_symmetric(&self) -> bool {
+        true
+    }
+
+    fn position(&self, state: StateId) -> Option<[f64; 3]> {
+        self.machine_cost().position(state)
+    }
+}
 
 /// Which precedence to impose.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
@@ -109,7 +157,7 @@ impl AfpOptions {
 #[derive(Clone, Debug)]
 pub struct AfpProblem {
     /// The problem: task `c` is course `c`; mode 0 forward, mode 1 (if any) reverse.
-    pub problem: Problem<MachineCost>,
+    pub problem: Problem<AfpCost>,
     /// Doherty et al.'s precedence sets, in order, as lists of courses (each ply alone when there are
     /// no footprints).
     pub sets: Vec<Vec<usize>>,
@@ -127,12 +175,25 @@ pub struct AfpProblem {
     pub edges: usize,
 }
 
-/// Builds the sequencing problem of a parsed program.
+/// Builds the sequencing problem of a parsed program, transits priced as one direct move (or
+/// by way of the dialect's clearance).
 pub fn build_problem(
     program: &Program,
     machine: &Machine,
     dialect: &Dialect,
     opts: &AfpOptions,
+) -> Result<AfpProblem, NcError> {
+    build_problem_with(program, machine, dialect, opts, None)
+}
+
+/// Builds the sequencing problem of a parsed program; with `safety`, every transit is priced as
+/// the transit the planner plans against the cell (the one [`crate::rewrite_with`] writes).
+pub fn build_problem_with(
+    program: &Program,
+    machine: &Machine,
+    dialect: &Dialect,
+    opts: &AfpOptions,
+    safety: Option<&Safety>,
 ) -> Result<AfpProblem, NcError> {
     let k = program.courses.len();
     crate::reverse::check_switch_scope(program, dialect)?;
@@ -191,12 +252,18 @@ pub fn build_problem(
     }
     let end_state = footer_end(program, machine, dialect)?.map(|s| states.push(&s)).transpose()?;
     let mut cost = MachineCost::new(machine.clone(), opts.cost, states)?;
-    if let Some((axis, value)) = dialect.clearance_axis(machine)? {
-        // The rewriter writes every transit by way of the clearance; the solver prices them so.
-        cost = cost.with_clearance(axis, value)?;
+    if safety.is_none() {
+        if let Some((axis, value)) = dialect.clearance_axis(machine)? {
+            // The rewriter writes every transit by way of the clearance; the solver prices them so.
+            cost = cost.with_clearance(axis, value)?;
+        }
     }
 
-    let mut b = Problem::builder(cost.clone());
+    let model = match safety {
+        Some(s) => AfpCost::Planned(Arc::new(TransitCost::new(s.planner().clone(), cost.clone()))),
+        None => AfpCost::Direct(cost.clone()),
+    };
+    let mut b = Problem::builder(model);
     for (c, ms) in modes.iter().enumerate() {
         b.task(
             ms.iter()

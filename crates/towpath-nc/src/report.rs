@@ -134,6 +134,8 @@ pub struct Report {
     /// Things the user should know: a width that disagrees with the dialect's, courses kept
     /// forward because of lines the dialect does not describe.
     pub warnings: Vec<String>,
+    /// Motion safety of the input and the output against the cell, when one was given.
+    pub safety: Option<crate::optimize::SafetyPair>,
 }
 
 fn pct(before: f64, after: f64) -> f64 {
@@ -263,7 +265,21 @@ impl Report {
                 crate::width::WidthSource::Dialect => "the dialect".into(),
                 crate::width::WidthSource::Default => "nowhere".into(),
             },
-            warnings: o.width.warning.iter().cloned().chain(forward_only(p, &o.afp.not_reversible)).collect(),
+            warnings: o
+                .width
+                .warning
+                .iter()
+                .cloned()
+                .chain(forward_only(p, &o.afp.not_reversible))
+                .chain(o.safety.iter().filter(|s| !s.before.is_safe()).map(|s| {
+                    format!(
+                        "the input program is not safe in this cell: {}; towpath wrote its transits anew, {}",
+                        s.before.summary(),
+                        s.before.details(3).join("; ")
+                    )
+                }))
+                .collect(),
+            safety: o.safety.clone(),
         }
     }
 
@@ -324,6 +340,10 @@ impl Report {
             }
         );
         let _ = writeln!(s, "  width: {}", self.width_line());
+        if let Some(sf) = &self.safety {
+            let _ = writeln!(s, "  motion safety, input:  {}", sf.before.summary());
+            let _ = writeln!(s, "  motion safety, output: {}", sf.after.summary());
+        }
         s
     }
 
@@ -604,7 +624,26 @@ fn plan_views(o: &Optimized, optimized: &Program, machine: &Machine) -> Option<S
     let pad = 0.08 * w.max(hgt);
     let stroke = 0.002 * w.max(hgt);
     let bar = scale_length(w);
-    let view = |id: &str, lines: &[(Option<usize>, Vec<[f64; 2]>)], off_color: &str, caption: &str, value: String| {
+    // Collisions (red) and near misses (orange) of each program, where a cell was given.
+    let marks = |report: Option<&crate::safety::SafetyReport>| -> Vec<([f64; 2], &'static str, String)> {
+        let Some(r) = report else { return Vec::new() };
+        let mark = |i: &crate::safety::MoveIssue, colour: &'static str, what: &str| {
+            (frame.map(i.at), colour, format!("line {}: {what}, {:.2} mm", i.line, i.clearance))
+        };
+        r.collisions
+            .iter()
+            .map(|i| mark(i, "#e00", "collision"))
+            .chain(r.near_misses.iter().map(|i| mark(i, "#f90", "near miss")))
+            .collect()
+    };
+    let marks_before = marks(o.safety.as_ref().map(|s| &s.before));
+    let marks_after = marks(o.safety.as_ref().map(|s| &s.after));
+    let view = |id: &str,
+                lines: &[(Option<usize>, Vec<[f64; 2]>)],
+                marks: &[([f64; 2], &'static str, String)],
+                off_color: &str,
+                caption: &str,
+                value: String| {
         let mut s = String::new();
         let _ = write!(
             s,
@@ -639,6 +678,18 @@ fn plan_views(o: &Optimized, optimized: &Program, machine: &Machine) -> Option<S
                 p[1],
                 6.0 * stroke,
                 stroke
+            );
+        }
+        for (p, colour, title) in marks {
+            let _ = write!(
+                s,
+                "<circle class=\"safety\" cx=\"{:.1}\" cy=\"{:.1}\" r=\"{:.2}\" fill=\"none\" stroke=\"{colour}\" \
+                 stroke-width=\"{:.2}\"><title>{}</title></circle>",
+                p[0],
+                p[1],
+                9.0 * stroke,
+                2.5 * stroke,
+                esc(title)
             );
         }
         s.push_str("</g>");
@@ -677,13 +728,19 @@ fn plan_views(o: &Optimized, optimized: &Program, machine: &Machine) -> Option<S
         legend,
         "<span><i style=\"background:#d22;height:2px\"></i>off-part before</span> \
          <span><i style=\"background:#14c;height:2px\"></i>off-part after</span> \
-         <span><b style=\"color:#0a0\">●</b> start</span> <span>▶ course direction</span></p>"
+         <span><b style=\"color:#0a0\">●</b> start</span> <span>▶ course direction</span>"
     );
+    if o.safety.is_some() {
+        legend.push_str(
+            " <span><b style=\"color:#e00\">○</b> collision</span> <span><b style=\"color:#f90\">○</b> near miss</span>",
+        );
+    }
+    legend.push_str("</p>");
     Some(format!(
         "<div class=\"views\">{}{}</div>{legend}<p>Laid courses coloured by ply, an arrow at each course's end; \
          thin lines: off-part motion{label}; the bar gives the scale in mm.</p>",
-        view("before", &before, "#d22", "before", off(&o.verification.before)),
-        view("after", &after, "#14c", "after", off(&o.verification.after))
+        view("before", &before, &marks_before, "#d22", "before", off(&o.verification.before)),
+        view("after", &after, &marks_after, "#14c", "after", off(&o.verification.after))
     ))
 }
 

@@ -18,6 +18,7 @@ use crate::error::NcError;
 use crate::interp::{wrap, Interp, Modal};
 use crate::program::{join_lines, Item, Program};
 use crate::reverse::{fmt_num, shift_decimal, Reversed};
+use towpath_motion::Planner;
 
 /// One course in the new order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -37,6 +38,20 @@ pub fn rewrite(
     dialect: &Dialect,
     reversed: &[Option<Reversed>],
 ) -> Result<String, NcError> {
+    rewrite_with(program, order, machine, dialect, reversed, None)
+}
+
+/// As [`rewrite`]; with a `planner`, every transit between courses is the planned one (straight
+/// where that keeps the clearance, else up, across and down at the least level that clears),
+/// also when the order is the original's, and a transit with no safe plan is refused.
+pub fn rewrite_with(
+    program: &Program,
+    order: &[Placement],
+    machine: &Machine,
+    dialect: &Dialect,
+    reversed: &[Option<Reversed>],
+    planner: Option<&Planner>,
+) -> Result<String, NcError> {
     let k = program.courses.len();
     if order.len() != k {
         return Err(NcError::Request(format!("the order has {} courses, the program {k}", order.len())));
@@ -47,7 +62,7 @@ pub fn rewrite(
             return Err(NcError::Request(format!("course {} is missing or repeated in the order", p.course)));
         }
     }
-    if order.iter().enumerate().all(|(i, p)| p.course == i && !p.reversed) {
+    if planner.is_none() && order.iter().enumerate().all(|(i, p)| p.course == i && !p.reversed) {
         return Ok(program.text());
     }
     // Write the reversed spans that are needed and not written yet.
@@ -79,6 +94,7 @@ pub fn rewrite(
         machine,
         crlf,
         clearance: dialect.clearance_axis(machine)?,
+        planner,
     };
     for j in 0..program.header_end {
         e.original(program, j)?;
@@ -180,6 +196,8 @@ struct Emitter<'a> {
     crlf: bool,
     /// Transits go by way of this value of this axis.
     clearance: Option<(usize, f64)>,
+    /// Transits are planned against the cell (the clearance above is then not used).
+    planner: Option<&'a Planner>,
 }
 
 impl Emitter<'_> {
@@ -222,6 +240,31 @@ impl Emitter<'_> {
     /// axis other than the clearance axis moves, three (to the clearance, across, and to the
     /// target's value); then set-position and mode lines if needed.
     fn transit(&mut self, target: &Modal) -> Result<(), NcError> {
+        if let Some(planner) = self.planner {
+            let cur = self.it.m.clone();
+            let plan = planner
+                .plan(&cur.phys, &target.phys)
+                .map_err(|e| NcError::Unsafe(format!("no safe transit to line {} ({e})", self.out.len() + 1)))?;
+            let n = plan.waypoints.len();
+            for w in plan.waypoints.iter().take(n.saturating_sub(1)) {
+                // An intermediate state: each axis moved from where it is now, the short way
+                // for wrapping axes (as `move_to` moves them), so no set-position is needed.
+                let now = self.it.m.clone();
+                let mut via = now.clone();
+                for (i, &v) in w.iter().enumerate() {
+                    let d = v - now.phys[i];
+                    let d = if self.machine.axes[i].kind.wraps() { wrap(d) } else { d };
+                    if d.abs() > 1e-9 {
+                        via.prog[i] = now.prog[i] + d;
+                        via.phys[i] = now.phys[i] + d;
+                        via.text[i] = None;
+                    }
+                }
+                self.move_to(&via)?;
+            }
+            self.move_to(target)?;
+            return self.restore_modes(target);
+        }
         if let Some((z, h)) = self.clearance {
             let cur = self.it.m.clone();
             let m = self.machine;

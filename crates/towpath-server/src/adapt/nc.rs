@@ -541,6 +541,7 @@ pub fn optimize(
         fell_back: fallback.is_some(),
         fallback,
         width,
+        safety: None,
     };
     let report = Report::new(file, machine, &o, &checked.afp);
     let report_json = serde_json::to_string_pretty(&report).map_err(|e| ApiError::Internal(e.to_string()))?;

@@ -138,3 +138,59 @@ pub fn load_machine(path: &Path) -> anyhow::Result<Machine> {
     let text = read(path)?;
     Machine::from_toml_str(&text).map_err(|e| exit::bad_input(anyhow::anyhow!("{}: {e}", path.display())))
 }
+
+/// The cell of a job, for motion safety (docs/motion.md).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct CellArgs {
+    /// An obstacle mesh (STL, OBJ or PLY, mm, in the part frame: on a mandrel machine it turns
+    /// with the mandrel): the mold tool, a fixture, a stringer; repeat for each. With it every
+    /// move is checked against the cell and the machine's travel limits, and `optimize` plans
+    /// each transit over the obstacles only as high as they require. The mold tool must be
+    /// among them: every laid point must lie within 25 mm of the cell. See docs/motion.md.
+    #[arg(long = "mold", value_name = "MESH")]
+    pub molds: Vec<PathBuf>,
+    /// Clearance in mm (default 5): a move closer than this to the cell is a near miss, and
+    /// planned transits keep it. Needs --mold.
+    #[arg(long, value_name = "MM", requires = "molds")]
+    pub clearance: Option<f64>,
+}
+
+impl CellArgs {
+    /// Declares the meshes as inputs.
+    pub fn declare(&self, files: &mut Files) -> anyhow::Result<()> {
+        for m in &self.molds {
+            files.input("mold mesh", m)?;
+        }
+        Ok(())
+    }
+
+    /// Reads the meshes into a cell and sets up the checks, or `None` without `--mold`.
+    pub fn load(&self, machine: &Machine, dialect: &Dialect) -> anyhow::Result<Option<towpath_nc::Safety>> {
+        if self.molds.is_empty() {
+            return Ok(None);
+        }
+        let mut soups = Vec::with_capacity(self.molds.len());
+        for path in &self.molds {
+            let soup = towpath_geom::io::read_path(path)
+                .map_err(|e| exit::bad_input(anyhow::anyhow!("{}: {e}", path.display())))?;
+            if let Err(e) = soup.validate() {
+                return Err(exit::bad_input(anyhow::anyhow!("{}: {e}", path.display())));
+            }
+            soups.push(soup);
+        }
+        let cell = towpath_motion::Cell::from_soups(&soups).map_err(|e| exit::bad_input(anyhow::anyhow!("{e}")))?;
+        if cell.num_triangles() == 0 {
+            return Err(exit::bad_input(anyhow::anyhow!(
+                "{}: no triangles: the cell is empty",
+                self.molds.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+            )));
+        }
+        let opts = towpath_nc::SafetyOptions {
+            clearance: self.clearance.unwrap_or(towpath_nc::DEFAULT_CLEARANCE),
+            ..towpath_nc::SafetyOptions::default()
+        };
+        towpath_nc::Safety::new(machine, dialect, std::sync::Arc::new(cell), opts)
+            .map(Some)
+            .map_err(|e| exit::bad_input(anyhow::anyhow!("--mold: {e}")))
+    }
+}

@@ -48,6 +48,11 @@ pub struct Args {
     pub solver: SolverArgs,
 }
 
+/// The file the demo writes a part's obstacle mesh to.
+fn obstacle_file(part: &str, obstacle: &str) -> String {
+    format!("{part}.{obstacle}.stl")
+}
+
 /// The file the demo writes a part's machine to.
 fn machine_file(m: &towpath_machine::Machine) -> String {
     format!("{}.toml", m.name)
@@ -64,6 +69,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut names: Vec<String> = ["gantry-afp.toml", "mandrel-afp.toml", "dialect.toml"].map(String::from).to_vec();
     for part in &parts {
         names.extend(["nc", "opt.nc", "html"].map(|ext| format!("{}.{ext}", part.name)));
+        names.extend(part.obstacles.iter().map(|o| obstacle_file(&part.name, &o.name)));
     }
     if dir.exists() && !dir.is_dir() {
         return Err(exit::bad_input(anyhow::anyhow!("{}: --dir names a file, not a directory", dir.display())));
@@ -115,10 +121,28 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     let mut rows = Vec::new();
+    let mut in_cells = Vec::new();
     for part in parts {
         let prog_path = dir.join(format!("{}.nc", part.name));
         let out_path = dir.join(format!("{}.opt.nc", part.name));
         files.write(&prog_path, &part.program)?;
+        let mut opts = opts.clone();
+        if !part.obstacles.is_empty() {
+            let mut all = Vec::new();
+            for ob in &part.obstacles {
+                let tris: Vec<[towpath_geom::DVec3; 3]> =
+                    ob.triangles.iter().map(|t| t.map(towpath_geom::DVec3::from_array)).collect();
+                let bytes = towpath_geom::io::write_bytes(
+                    &towpath_geom::Soup::from_triangles(tris.iter().copied()),
+                    towpath_geom::io::Format::Stl,
+                )?;
+                files.write(&dir.join(obstacle_file(&part.name, &ob.name)), bytes)?;
+                all.extend(tris);
+            }
+            let cell = std::sync::Arc::new(towpath_motion::Cell::from_triangles(all));
+            opts.safety = Some(towpath_nc::Safety::new(&part.machine, &dialect, cell, Default::default())?);
+            in_cells.push(part.name.clone());
+        }
         let o = optimize(&part.program, &part.machine, &dialect, &opts)
             .map_err(|e| classify(&prog_path, &dir.join(machine_file(&part.machine)), e))?;
         files.write(&out_path, &o.text)?;
@@ -172,7 +196,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "optimized": out_path,
             "solver": o.solver.solver,
             "seconds": o.timings.total,
+            "safety": o.safety,
         }));
+        if let (Some(sf), false) = (&o.safety, args.json) {
+            outln!("{:<22} motion safety: input {}", "", sf.before.summary());
+            outln!("{:<22} output {}", "", sf.after.summary());
+        }
     }
     files.write(&manifest_path, manifest_text)?;
     files.commit()?;

@@ -7,7 +7,7 @@ use std::time::Duration;
 use towpath_machine::CostKind;
 use towpath_nc::{optimize, AfpOptions, NcError, OptimizeOptions, PrecedenceRule, Report};
 
-use super::afp_common::{lines_with, machine_hint, read, warn, width_from, MachineArgs};
+use super::afp_common::{lines_with, machine_hint, read, warn, width_from, CellArgs, MachineArgs};
 use super::solver_args::SolverArgs;
 use crate::files::Files;
 use crate::{exit, outln};
@@ -20,6 +20,8 @@ pub struct Args {
     pub program: PathBuf,
     #[command(flatten)]
     pub machine: MachineArgs,
+    #[command(flatten)]
+    pub cell: CellArgs,
     /// Allow courses to be laid in reverse (heading turned 180°, tow restarts and cuts swapped).
     #[arg(long)]
     pub bidirectional: bool,
@@ -67,7 +69,7 @@ pub struct Args {
 pub fn classify(file: &std::path::Path, machine: &std::path::Path, e: NcError) -> anyhow::Error {
     let hint = machine_hint(&e, machine);
     match e {
-        NcError::SelfCheck(_) => exit::check_failed(anyhow::anyhow!("{}: {e}", file.display())),
+        NcError::SelfCheck(_) | NcError::Unsafe(_) => exit::check_failed(anyhow::anyhow!("{}: {e}", file.display())),
         // Everything else, a solver that cannot take this program (`NcError::Solver`) included,
         // refuses the input.
         _ => exit::bad_input(anyhow::anyhow!("{}: {e}{hint}", file.display())),
@@ -79,12 +81,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let given_limit = args.time_limit.map(super::solver_args::time_limit).transpose()?;
     let mut files = Files::new();
     args.machine.declare(&mut files)?;
+    args.cell.declare(&mut files)?;
     files.input("program", &args.program)?;
     files.output("output", &args.output)?;
     if let Some(r) = &args.report {
         files.output("report", r)?;
     }
     let (machine, dialect, width) = args.machine.load()?;
+    let safety = args.cell.load(&machine, &dialect)?;
     let text = read(&args.program)?;
     let afp = AfpOptions {
         cost: args.cost.unwrap_or_else(|| towpath_nc::default_cost(&machine)),
@@ -118,6 +122,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }),
         solver: args.solver.solver,
         baselines: args.solver.params(),
+        safety,
     };
     let o = optimize(&text, &machine, &dialect, &opts).map_err(|e| classify(&args.program, &args.machine.machine, e));
     if let Some(b) = &bar {

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use towpath_nc::{totals, verify, PrecedenceRule, VerifyError, VerifyOptions};
 
-use super::afp_common::{machine_hint, read, warn, width_from, MachineArgs};
+use super::afp_common::{machine_hint, read, warn, width_from, CellArgs, MachineArgs};
 use crate::{exit, outln};
 
 /// Arguments of `towpath verify`.
@@ -19,6 +19,8 @@ pub struct Args {
     pub optimized: PathBuf,
     #[command(flatten)]
     pub machine: MachineArgs,
+    #[command(flatten)]
+    pub cell: CellArgs,
     /// The precedence the optimized program must keep: a course after the courses of earlier
     /// plies it overlaps (courses, always checked), and also Doherty et al.'s precedence sets in order
     /// (sets) or every ply finished before the next starts (plies), as `optimize --precedence`.
@@ -38,6 +40,7 @@ pub struct Args {
 /// Runs `towpath verify`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let (machine, dialect, width) = args.machine.load()?;
+    let safety = args.cell.load(&machine, &dialect)?;
     let original = read(&args.original)?;
     let optimized = read(&args.optimized)?;
     let opts = VerifyOptions {
@@ -62,6 +65,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
     })?;
     let t = totals(&v);
+    let safety = check_safety(&args, &original, &optimized, &machine, &dialect, safety.as_ref())?;
+    let unsafe_after = !safety.after.is_safe();
     let from = width_from(&args.machine, &v.width, &args.machine.dialect_name());
     if let Some(w) = &v.width.warning {
         warn(w);
@@ -87,9 +92,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 "warnings": v.width.warning.iter().collect::<Vec<_>>(),
                 "cycle_time": t.iter().find(|x| x.kind == towpath_machine::CostKind::Time),
                 "totals": t,
+                "safety": safety_json(&safety),
             })
         );
-        return Ok(());
+        return safety_verdict(&args, &safety);
     }
     outln!(
         "verified: {} courses, same motion on-part ({} laid in reverse), precedence {}",
@@ -109,5 +115,85 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     outln!("  width: {width}");
     crate::out!("{}", towpath_nc::totals_table(&t));
-    Ok(())
+    if safety.checked_cell {
+        outln!("  motion safety, original:  {}", safety.before.summary());
+        outln!("  motion safety, optimized: {}", safety.after.summary());
+    }
+    if unsafe_after || safety.before.near_misses.len() < safety.after.near_misses.len() {
+        for line in safety.after.details(10) {
+            outln!("    {line}");
+        }
+    }
+    safety_verdict(&args, &safety)
+}
+
+/// The motion safety of both programs: against the cell with `--mold`, else the travel
+/// limits only.
+struct SafetyBoth {
+    before: towpath_nc::SafetyReport,
+    after: towpath_nc::SafetyReport,
+    checked_cell: bool,
+}
+
+fn check_safety(
+    args: &Args,
+    original: &str,
+    optimized: &str,
+    machine: &towpath_machine::Machine,
+    dialect: &towpath_nc::Dialect,
+    safety: Option<&towpath_nc::Safety>,
+) -> anyhow::Result<SafetyBoth> {
+    let parse = |text: &str, path: &std::path::Path| {
+        towpath_nc::parse(text, machine, dialect)
+            .map_err(|e| exit::bad_input(anyhow::anyhow!("{}: {e}", path.display())))
+    };
+    let (a, b) = (parse(original, &args.original)?, parse(optimized, &args.optimized)?);
+    Ok(match safety {
+        Some(s) => {
+            towpath_nc::check_cell_under_path(&a, machine, s, towpath_nc::MOLD_GAP)
+                .map_err(|e| exit::bad_input(anyhow::anyhow!("{}: {e}", args.original.display())))?;
+            SafetyBoth {
+                before: towpath_nc::check_program(&a, s),
+                after: towpath_nc::check_program(&b, s),
+                checked_cell: true,
+            }
+        }
+        None => {
+            let limits = |p: &towpath_nc::Program| towpath_nc::SafetyReport {
+                limit_violations: towpath_nc::limit_violations(p, machine),
+                ..towpath_nc::SafetyReport::default()
+            };
+            SafetyBoth { before: limits(&a), after: limits(&b), checked_cell: false }
+        }
+    })
+}
+
+fn safety_json(s: &SafetyBoth) -> serde_json::Value {
+    let one = |r: &towpath_nc::SafetyReport| {
+        serde_json::json!({
+            "collisions": r.collisions.len(),
+            "near_misses": r.near_misses.len(),
+            "limit_violations": r.limit_violations.len(),
+            "min_clearance": r.min_clearance.map(|(c, _)| c),
+            "min_clearance_line": r.min_clearance.map(|(_, l)| l),
+            "moves_checked": r.moves_checked,
+            "details": r,
+        })
+    };
+    serde_json::json!({
+        "cell_checked": s.checked_cell,
+        "clearance": s.checked_cell.then_some(s.after.clearance),
+        "original": one(&s.before),
+        "optimized": one(&s.after),
+    })
+}
+
+/// Exit 3 when the optimized program collides or leaves the travel limits.
+fn safety_verdict(args: &Args, s: &SafetyBoth) -> anyhow::Result<()> {
+    if s.after.is_safe() {
+        return Ok(());
+    }
+    let already =
+        if s.before.is_safe() { String::new() } else { format!("; the original already has {}", s.before.summary()) };
+    Err(exit::check_failed(anyhow::anyhow!("{}: not safe: {}{already}", args.optimized.display(), s.after.summary())))
 }

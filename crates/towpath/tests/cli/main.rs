@@ -9,6 +9,7 @@ mod cycle_time;
 mod layup;
 mod layup_report;
 mod machine;
+mod motion;
 mod order;
 mod outputs_and_pipes;
 mod route;

@@ -90,6 +90,25 @@ fn every_command_ends_quietly_on_a_closed_stdout() {
     );
     assert!(courses.exists(), "layup still wrote its courses");
 
+    ran.push("spray");
+    let plan = d.join("spray.json");
+    closed_stdout(
+        towpath()
+            .args([
+                "spray",
+                "plane:a=300,b=200",
+                "--standoff",
+                "200",
+                "--spray-radius",
+                "60",
+                "--target-thickness",
+                "50",
+                "-o",
+            ])
+            .arg(&plan),
+    );
+    assert!(plan.exists(), "spray still wrote its plan");
+
     // order prints the ordered drawing when no output is named.
     ran.push("order");
     let svg = d.join("strokes.svg");
