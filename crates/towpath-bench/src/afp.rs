@@ -76,7 +76,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     ));
     md.push_str("| part | courses | Doherty et al. off-part | Doherty et al. total | towpath off-part (axis) | towpath off-part (tool) | towpath total (tool) | towpath unidirectional off-part (axis) | towpath off-part time, optimizing time | doherty (Doherty et al.'s algorithm) off-part (axis) | doherty solve | towpath off-part (axis) at doherty's solve time | towpath solve | time per run |\n");
     md.push_str("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-    for part in demo_parts().into_iter().filter(|_| a.runs > 0) {
+    // Parts in a cell belong to `towpath-bench motion`.
+    for part in demo_parts().into_iter().filter(|p| a.runs > 0 && p.obstacles.is_empty()) {
         let mut off_axis = Vec::new();
         let mut off_tool = Vec::new();
         let mut total_tool = Vec::new();

@@ -4,17 +4,21 @@
 //! cargo run --release -p towpath-bench -- baselines [--quick] [--data DIR] [--write BENCHMARKS.md]
 //! cargo run --release -p towpath-bench -- afp [--runs N] [--write BENCHMARKS.md]
 //! cargo run --release -p towpath-bench -- layup [OUT_DIR] [--repeats N]
+//! cargo run --release -p towpath-bench -- motion [--runs N] [--write BENCHMARKS.md]
 //! ```
 //!
 //! `baselines` runs the papers' own solvers (Doherty et al. 2022, Castelino et al. 2003, Tewolde
 //! & Sheng 2008) against towpath's; `afp` the AFP programs of `towpath demo` and a 10,000-course
 //! panel; `layup` the course-tracing accuracy study that `bench/layup.py` compares with
-//! potpourri3d. The benchmark data directory (GTSP-LIB, PCGLNS) comes from `--data` or the
+//! potpourri3d; `motion` the motion-safety figures (transits straight, planned or over a fixed
+//! clearance; a 10,000-course panel with its tool; checking speed on a 1,000,000-triangle mold). The benchmark data directory (GTSP-LIB, PCGLNS) comes from `--data` or the
 //! environment variable `TOWPATH_BENCH_DATA`; `TOWPATH_BENCH_MACHINE` names the CPU in captions.
 
 mod afp;
 mod baselines;
 mod layup;
+mod motion;
+mod motion_speed;
 mod stats;
 
 use clap::{Parser, Subcommand};
@@ -38,6 +42,9 @@ enum Which {
     Afp(afp::Args),
     /// Course tracing accuracy and speed (the driver of bench/layup.py).
     Layup(layup::Args),
+    /// Motion safety: transits straight, planned or over a fixed clearance; a large panel in
+    /// its cell; checking speed.
+    Motion(motion::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -46,6 +53,7 @@ fn main() -> std::process::ExitCode {
         Which::Baselines(a) => baselines::run(a),
         Which::Afp(a) => afp::run(a),
         Which::Layup(a) => layup::run(a),
+        Which::Motion(a) => motion::run(a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -175,6 +175,26 @@ fn note(p: &Piece, upper: &mut f64, at: &mut Option<(f64, Body)>) {
 /// Pieces shorter than this (in the move parameter) are not split further.
 const MIN_PIECE: f64 = 1e-9;
 
+/// Most pieces a range is cut into before its first queries.
+const MAX_FIRST_PIECES: f64 = 4096.0;
+
+/// Cuts `[ta, tb]` into equal pieces whose chord error bound (bend·h²/8) is at most `limit`:
+/// a piece whose chord may stray far from its path would be queried with a cap as wide as
+/// that error, over every triangle within it (the whole mold under a long curved transit),
+/// to be split anyway.
+fn first_pieces(bend: f64, ta: f64, tb: f64, limit: f64) -> Vec<(f64, f64)> {
+    let h = tb - ta;
+    let n = if bend > 0.0 && limit > 0.0 {
+        (h * (bend / (8.0 * limit)).sqrt()).ceil().clamp(1.0, MAX_FIRST_PIECES)
+    } else {
+        1.0
+    };
+    let n = n as usize;
+    (0..n)
+        .map(|k| (ta + h * k as f64 / n as f64, if k + 1 == n { tb } else { ta + h * (k + 1) as f64 / n as f64 }))
+        .collect()
+}
+
 impl Checker {
     /// A checker of moves of `rig` against `cell`.
     pub fn new(cell: Arc<Cell>, rig: Arc<Rig>, opts: CheckOptions) -> Checker {
@@ -255,8 +275,11 @@ impl Checker {
         }
         let mut buf = Vec::with_capacity(self.rig.dim());
         let tol = self.opts.tolerance;
-        let (pa, pb) = (path.pose(ta, &mut buf), path.pose(tb, &mut buf));
-        let mut stack = vec![(ta, tb, pa, pb)];
+        let mut stack: Vec<(f64, f64, Pose, Pose)> = first_pieces(path.bend, ta, tb, c.max(tol))
+            .into_iter()
+            .rev()
+            .map(|(t0, t1)| (t0, t1, path.pose(t0, &mut buf), path.pose(t1, &mut buf)))
+            .collect();
         while let Some((t0, t1, p0, p1)) = stack.pop() {
             let p = self.piece(path.bend, t0, t1, p0, p1, c, Some(c));
             if p.lb >= c {
@@ -279,13 +302,17 @@ impl Checker {
         let tol = self.opts.tolerance;
         let horizon = self.opts.horizon;
         let mut buf = Vec::with_capacity(self.rig.dim());
-        let (pa, pb) = (path.pose(ta, &mut buf), path.pose(tb, &mut buf));
-        let first = self.piece(path.bend, ta, tb, pa, pb, horizon, None);
         let mut upper = horizon;
         let mut at = None;
-        note(&first, &mut upper, &mut at);
         let mut heap = BinaryHeap::new();
-        heap.push(first);
+        for (t0, t1) in first_pieces(path.bend, ta, tb, horizon) {
+            let (p0, p1) = (path.pose(t0, &mut buf), path.pose(t1, &mut buf));
+            let first = self.piece(path.bend, t0, t1, p0, p1, upper, None);
+            note(&first, &mut upper, &mut at);
+            if first.lb < upper {
+                heap.push(first);
+            }
+        }
         let mut resolved = f64::INFINITY;
         let lower = loop {
             if upper < tol {

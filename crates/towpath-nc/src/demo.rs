@@ -86,14 +86,22 @@ pub fn plate_mesh(x: [f64; 2], y: [f64; 2], z: f64) -> Vec<[[f64; 3]; 3]> {
     vec![[p(0, 0), p(1, 0), p(1, 1)], [p(0, 0), p(1, 1), p(0, 1)]]
 }
 
-/// A cylinder about the X axis: radius `r` from `x0` to `x1`, `n` facets round, each facet's
-/// edges on the radius (so the facets lie just inside it).
+/// A cylinder about the X axis: radius `r` from `x0` to `x1`, `n` facets round and rings of at
+/// most 100 mm along (so that no triangle is long and thin), each facet's corners on the
+/// radius (so the facets lie just inside it).
 pub fn cylinder_mesh(r: f64, x0: f64, x1: f64, n: usize) -> Vec<[[f64; 3]; 3]> {
-    let at = |x: f64, k: usize| {
+    let rings = ((x1 - x0).abs() / 100.0).ceil().max(1.0) as usize;
+    let at = |i: usize, k: usize| {
         let a = std::f64::consts::TAU * k as f64 / n as f64;
-        [x, r * a.cos(), r * a.sin()]
+        [x0 + (x1 - x0) * i as f64 / rings as f64, r * a.cos(), r * a.sin()]
     };
-    (0..n).flat_map(|k| [[at(x0, k), at(x1, k), at(x1, k + 1)], [at(x0, k), at(x1, k + 1), at(x0, k + 1)]]).collect()
+    (0..rings)
+        .flat_map(|i| {
+            (0..n).flat_map(move |k| {
+                [[at(i, k), at(i + 1, k), at(i + 1, k + 1)], [at(i, k), at(i + 1, k + 1), at(i, k + 1)]]
+            })
+        })
+        .collect()
 }
 
 /// A flange about the X axis: a ring from radius `r0` to `r1`, between `x0` and `x1`, `n`

@@ -12,7 +12,9 @@ use crate::error::NcError;
 use crate::problem::{build_problem_with, placements, AfpOptions, AfpProblem};
 use crate::program::Program;
 use crate::rewrite::{rewrite, rewrite_with, Placement};
-use crate::safety::{check_cell_under_path, check_program, limit_violations, Safety, SafetyReport, MOLD_GAP};
+use crate::safety::{
+    check_cell_under_path, check_courses_within_limits, check_program, limit_violations, Safety, SafetyReport, MOLD_GAP,
+};
 use crate::sequencer::sequence;
 use crate::verify::{verify_parsed, Verification, VerifyOptions};
 
@@ -167,6 +169,7 @@ pub fn optimize(
     let t_parse = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let safety = opts.safety.as_ref();
+    check_courses_within_limits(&program, machine)?;
     let input_safety = match safety {
         Some(sf) => {
             check_cell_under_path(&program, machine, sf, MOLD_GAP)?;
@@ -188,9 +191,7 @@ pub fn optimize(
             iterations: opts.iterations,
             seed: opts.seed,
             threads: opts.threads.max(1),
-            // With a cell, the input order may hold a transit that cannot be made safe (no level
-            // within the travel limits clears): it is then no starting point.
-            initial: (safety.is_none() || check(&afp.problem, &afp.original).is_ok()).then(|| afp.original.clone()),
+            initial: Some(afp.original.clone()),
             progress: opts.progress.clone(),
             ..SolveOptions::default()
         },
@@ -270,10 +271,12 @@ pub fn optimize(
             // Without a cell, the travel limits are still checked on what is written.
             let parsed = crate::parse::parse(&out, machine, dialect).map_err(|e| NcError::SelfCheck(e.to_string()))?;
             let outside = limit_violations(&parsed, machine);
-            if !outside.is_empty() && limit_violations(&program, machine).is_empty() {
+            if !outside.is_empty() {
+                let input = limit_violations(&program, machine).len();
                 let report = SafetyReport { limit_violations: outside, ..SafetyReport::default() };
                 return Err(NcError::Unsafe(format!(
-                    "the program towpath would write leaves the travel limits:\n{}",
+                    "the program towpath would write leaves the travel limits ({}):\n{}",
+                    if input > 0 { format!("the input does too, on {input} lines") } else { "the input does not".into() },
                     report.details(5).join("\n")
                 )));
             }

@@ -320,8 +320,10 @@ pub fn limit_violations(program: &Program, machine: &Machine) -> Vec<LimitIssue>
     out
 }
 
-/// Refuses a cell that does not lie under the program's laid path (wrong mesh, units or frame):
-/// every laid tool point must be within `max_gap` mm of some obstacle triangle.
+/// Refuses a set-up the checks would be meaningless in: laid points on (within
+/// [`MIN_MANDREL_RADIUS`] of) a mandrel's axis, or a cell that does not lie under the program's
+/// laid path (wrong mesh, units or frame): every laid tool point must be within `max_gap` mm of
+/// some obstacle triangle.
 pub fn check_cell_under_path(
     program: &Program,
     machine: &Machine,
@@ -335,6 +337,33 @@ pub fn check_cell_under_path(
         .filter(|s| s.on_part)
         .flat_map(|s| [points[s.from as usize], points[s.to as usize]])
         .collect();
-    towpath_motion::check_laid_points(safety.checker().cell(), &laid, max_gap)
-        .map_err(|e| NcError::Request(e.to_string()))
+    towpath_motion::check_mandrel_radius(safety.checker().rig(), &laid, MIN_MANDREL_RADIUS)
+        .map_err(|e| NcError::Request(e.to_string()))?;
+    towpath_motion::check_laid_points(safety.checker().cell(), &laid, max_gap).map_err(|e| NcError::Request(e.to_string()))
+}
+
+/// Laid points closer than this to a mandrel's axis are refused, mm: a course cannot be laid
+/// there, and angles round the mandrel mean nothing.
+pub const MIN_MANDREL_RADIUS: f64 = 1.0;
+
+/// Refuses a program that lays a course outside the travel limits, naming the course and line.
+pub fn check_courses_within_limits(program: &Program, machine: &Machine) -> Result<(), NcError> {
+    let outside = limit_violations(program, machine);
+    for (c, course) in program.courses.iter().enumerate() {
+        if let Some(l) = outside.iter().find(|l| course.on_part.contains(&(l.line - 1))) {
+            let lim = |v: Option<f64>| v.map_or_else(|| "none".to_string(), |v| v.to_string());
+            return Err(NcError::Line {
+                line: l.line,
+                message: format!(
+                    "{} is laid outside the travel limits: axis {} at {} is outside [{}, {}]",
+                    program.course_name(c),
+                    l.axis,
+                    l.value,
+                    lim(l.min),
+                    lim(l.max)
+                ),
+            });
+        }
+    }
+    Ok(())
 }

@@ -66,7 +66,9 @@ pub fn sequence(
     solve_opts: &SolveOptions,
 ) -> Result<SolveReport, NcError> {
     let mut solve_opts = solve_opts.clone();
-    solve_opts.initial = Some(afp.original.clone());
+    // The program's own order is the starting point, when it is feasible (with a cell, a
+    // transit of the input may have no safe plan).
+    solve_opts.initial = towpath_seq::check(&afp.problem, &afp.original).is_ok().then(|| afp.original.clone());
     let named = |e: BaselineError| match e {
         BaselineError::Solve(e) => NcError::from(e),
         e => {

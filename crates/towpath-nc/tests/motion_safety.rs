@@ -191,7 +191,34 @@ fn no_safe_transit_within_the_travel_limits_is_refused() {
     // The demo's header and footer go to Z100: bring them within the limit.
     let program = p.program.replace("G0 Z100", "G0 Z30");
     let s = Safety::new(&m, &dialect(), cell_of(&p), SafetyOptions::default()).unwrap();
-    let e = optimize(&program, &m, &dialect(), &opts(Some(s))).unwrap_err();
+    // A small work budget: every kick of an infeasible search runs its descent to the end.
+    let e = optimize(&program, &m, &dialect(), &OptimizeOptions { iterations: Some(50), ..opts(Some(s)) }).unwrap_err();
     assert!(matches!(e, NcError::Unsafe(_)), "{e}");
     assert!(e.to_string().contains("can be made safe (a clearance of 5 mm within the travel limits)"), "{e}");
+}
+
+#[test]
+fn laid_points_on_the_mandrel_axis_are_refused() {
+    let p = part("cylinder-flange");
+    let d = dialect();
+    // The mandrel axis moved 400 mm, onto the surface the program lays on.
+    let mut m = p.machine.clone();
+    let a = m.axis_index("A").unwrap();
+    m.axes[a].origin = Some([0.0, 0.0, 400.0]);
+    let s = Safety::new(&m, &d, cell_of(&p), SafetyOptions::default()).unwrap();
+    let program = parse(&p.program, &m, &d).unwrap();
+    let e = check_cell_under_path(&program, &m, &s, towpath_nc::MOLD_GAP).unwrap_err();
+    assert!(e.to_string().contains("from the mandrel axis (at least 1 mm needed)"), "{e}");
+}
+
+#[test]
+fn a_course_laid_outside_the_travel_limits_is_refused() {
+    let p = part("planar-45");
+    let mut m = p.machine.clone();
+    let x = m.axis_index("X").unwrap();
+    m.axes[x].max = Some(1000.0);
+    let e = optimize(&p.program, &m, &dialect(), &opts(None)).unwrap_err();
+    let text = e.to_string();
+    assert!(matches!(e, NcError::Line { .. }), "{e}");
+    assert!(text.contains("is laid outside the travel limits: axis X at") && text.contains("outside [none, 1000]"), "{e}");
 }

@@ -49,3 +49,48 @@ fn routes_avoid_forbidden_arcs() {
         assert!(c.is_finite() && (c - r.solution.cost).abs() < 1e-6);
     }
 }
+
+/// When every route needs a forbidden transition, a solve under a work budget (no time limit)
+/// ends, saying no feasible route exists. (The case where rounding in the huge forbidden price
+/// made the local search cycle for ever is towpath-nc's
+/// `no_safe_transit_within_the_travel_limits_is_refused`; these matrices do not reproduce it.)
+#[test]
+fn infeasible_problems_end_under_a_work_budget() {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for seed in 0..10u64 {
+            let mut rng = Pcg64Mcg::seed_from_u64(seed);
+            let n = rng.gen_range(20..60usize);
+            // Two clusters; every transition between them is forbidden, so a closed tour
+            // through both cannot exist.
+            let side = |i: usize| i % 2 == 0;
+            let data: Vec<f64> = (0..n * n)
+                .map(|x| {
+                    let (i, j) = (x / n, x % n);
+                    if i == j {
+                        0.0
+                    } else if side(i) != side(j) {
+                        f64::INFINITY
+                    } else {
+                        rng.gen_range(1.0..1000.0_f64) * 1.000_000_1
+                    }
+                })
+                .collect();
+            let mut b = Problem::builder(MatrixCost::new(n, data).unwrap());
+            b.point_tasks(n);
+            let p = b.build().unwrap();
+            let opts = SolveOptions {
+                time_limit: None,
+                iterations: Some(300),
+                threads: 1,
+                seed,
+                exact_up_to: 0,
+                ..Default::default()
+            };
+            let r = solve(&p, &opts);
+            assert!(matches!(r, Err(SolveError::NoFeasibleRoute(_))), "seed {seed}: {:?}", r.map(|r| r.solution.cost));
+        }
+        let _ = tx.send(());
+    });
+    rx.recv_timeout(std::time::Duration::from_secs(120)).expect("the solves end within two minutes");
+}

@@ -181,6 +181,11 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
     pub fn run(&mut self, tour: &mut Tour) -> bool {
         let mut improved = false;
         let mut count = 0u32;
+        // Every move gains at least `eps` in exact arithmetic, so a descent ends; with forbidden
+        // arcs in the tour (priced at 10¹² or more) rounding can make a cycle of moves look
+        // improving. A descent far longer than any real one is stopped.
+        let max_moves = 100 * self.net.n as u64 + 10_000;
+        let mut moves = 0u64;
         while let Some(v) = self.queue.pop_front() {
             self.queued[v as usize] = false;
             count += 1;
@@ -206,6 +211,11 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
                 improved = true;
                 self.moves += 1;
                 self.push(v);
+                moves += 1;
+                if moves >= max_moves {
+                    self.clear();
+                    break;
+                }
             }
         }
         improved

@@ -1,6 +1,5 @@
-//! Checking and planning speed: 10,000 transits against a 1,000,000-triangle mold.
-//!
-//! `cargo run --release -p towpath-motion --example motion_bench [-- RUNS]`
+//! Checking and planning speed of `towpath-motion`: 10,000 transits against a
+//! 1,000,000-triangle mold (part of `towpath-bench motion`).
 //!
 //! The mold is a wavy plate 2000 × 1000 mm (z = 30·sin(x/300)·cos(y/200), 708 × 707 quads,
 //! 1,000,912 triangles) with a stringer across it (a box 40 mm wide, 60 mm high) and a fixture
@@ -12,6 +11,8 @@
 
 use std::sync::Arc;
 use std::time::Instant;
+
+use crate::stats::{cpu_seconds, machine as machine_line, median};
 
 use towpath_geom::DVec3;
 use towpath_machine::Machine;
@@ -87,20 +88,6 @@ impl Lcg {
     }
 }
 
-/// CPU time of this process so far (all threads), seconds, from /proc (0 where unavailable):
-/// on a machine shared with other work it shows what the run itself cost.
-fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let fields: Vec<&str> = stat.rsplit(')').next().unwrap_or("").split_whitespace().collect();
-    let ticks = |i: usize| fields.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
-    (ticks(11) + ticks(12)) / 100.0
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 /// Runs `f` over `items` on two threads.
 fn on_two_threads<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
     let mid = items.len() / 2;
@@ -113,12 +100,12 @@ fn on_two_threads<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> 
     })
 }
 
-fn main() {
-    let runs: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(5);
-    let count: usize = std::env::args().nth(2).and_then(|s| s.parse().ok()).unwrap_or(10_000);
+/// Runs the speed benchmark: `runs` runs of `count` transits; returns a Markdown section body.
+pub fn run(runs: usize, count: usize) -> anyhow::Result<String> {
+    let runs = runs.max(1);
     let tris = mold();
-    let machine = Machine::from_toml_str(GANTRY).expect("machine");
-    let rig = Arc::new(Rig::new(&machine, Some(Head { radius: 30.0, bottom: 35.0, top: 300.0 })).expect("rig"));
+    let machine = Machine::from_toml_str(GANTRY)?;
+    let rig = Arc::new(Rig::new(&machine, Some(Head { radius: 30.0, bottom: 35.0, top: 300.0 }))?);
     let mut rng = Lcg(7);
     let mut end = || {
         let (x, y) = (50.0 + 1900.0 * rng.next(), 50.0 + 900.0 * rng.next());
@@ -127,8 +114,9 @@ fn main() {
         vec![x, y, height(x, y) + 25.0, 360.0 * rng.next() - 180.0]
     };
     let pairs: Vec<(Vec<f64>, Vec<f64>)> = (0..count).map(|_| (end(), end())).collect();
-    println!("mold: {} triangles; {} transits; {runs} runs", tris.len(), pairs.len());
-    let (mut build, mut check, mut plan, mut cpu) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    eprintln!("motion speed: mold of {} triangles; {} transits; {runs} runs", tris.len(), pairs.len());
+    let (mut build, mut check, mut plan) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut cb, mut cc, mut cp) = (Vec::new(), Vec::new(), Vec::new());
     let mut summary = String::new();
     for _ in 0..runs {
         // The caller holds the meshes; building the cell from them is timed.
@@ -139,32 +127,47 @@ fn main() {
         let checker = Checker::new(cell, rig.clone(), CheckOptions::default());
         let checks = on_two_threads(&pairs, |(a, b)| checker.check(a, b, Contact::None));
         let (t2, c2) = (Instant::now(), cpu_seconds());
-        let planner = Planner::new(checker.clone(), PlanOptions::default()).expect("planner");
+        let planner = Planner::new(checker.clone(), PlanOptions::default())?;
         let plans = on_two_threads(&pairs, |(a, b)| planner.plan(a, b));
         let (t3, c3) = (Instant::now(), cpu_seconds());
-        cpu.push((c1 - c0, c2 - c1, c3 - c2));
         build.push((t1 - t0).as_secs_f64());
         check.push((t2 - t1).as_secs_f64());
         plan.push((t3 - t2).as_secs_f64());
+        cb.push(c1 - c0);
+        cc.push(c2 - c1);
+        cp.push(c3 - c2);
         let collisions = checks.iter().filter(|c| c.collision).count();
         let near = checks.iter().filter(|c| c.near_miss).count();
-        let worst = checks.iter().filter_map(|c| c.min_clearance).fold(f64::INFINITY, f64::min);
         let lifted = plans.iter().filter(|p| matches!(p, Ok(t) if t.level.is_some())).count();
         let failed = plans.iter().filter(|p| p.is_err()).count();
         summary = format!(
-            "straight transits: {collisions} collide, {near} near misses, worst clearance {worst:.3} mm; \
-             planned: {lifted} lifted, {} straight, {failed} without a safe transit",
+            "Outcome: {collisions} straight transits collide (they cross the stringer or the clamp), {near} are near \
+             misses; the planner lifts {lifted}, keeps {} straight and finds no safe transit for {failed} (ends whose \
+             head already touches the clamp).",
             plans.len() - lifted - failed
         );
     }
-    println!("{summary}");
-    let (b, c, p) = (median(build), median(check), median(plan));
-    let cb = median(cpu.iter().map(|x| x.0).collect());
-    let cc = median(cpu.iter().map(|x| x.1).collect());
-    let cp = median(cpu.iter().map(|x| x.2).collect());
-    let n = pairs.len();
-    println!("medians of {runs} runs, 2 threads (wall s | CPU s of this process, both threads):");
-    println!("  build cell (BVH)        {b:>7.3} | {cb:>7.3}");
-    println!("  check {n} straight moves {c:>7.3} | {cc:>7.3}   with build: {:.3} | {:.3}", b + c, cb + cc);
-    println!("  plan {n} transits        {p:>7.3} | {cp:>7.3}   with build: {:.3} | {:.3}", b + p, cb + cp);
+    let (b, c, p) = (median(&build), median(&check), median(&plan));
+    let (cb, cc, cp) = (median(&cb), median(&cc), median(&cp));
+    let mut md = format!(
+        "A wavy plate 2000 × 1000 mm of 1,000,912 triangles with a stringer across it and a fixture clamp \
+         ({} triangles), a gantry with a head capsule (radius 30, 35–300 mm above the tool point), {} transits \
+         between random course ends 25 mm above the surface; two threads; medians of {runs} runs ({}). CPU time \
+         is the process's own (both threads): on a shared machine it shows what the work costs.\n\n",
+        tris.len(),
+        pairs.len(),
+        machine_line()
+    );
+    md.push_str("| step | wall s | CPU s (both threads) |\n|---|---:|---:|\n");
+    for (what, w, cpu) in [
+        ("build the cell (Morton order, two BVHs built side by side)", b, cb),
+        ("check every straight transit (least clearance, collision, near miss, limits)", c, cc),
+        ("plan every transit (straight or lifted to the least clearing level)", p, cp),
+        ("build + check", b + c, cb + cc),
+        ("build + plan", b + p, cb + cp),
+    ] {
+        md.push_str(&format!("| {what} | {w:.3} | {cpu:.3} |\n"));
+    }
+    md.push_str(&format!("\n{summary}\n"));
+    Ok(md)
 }
