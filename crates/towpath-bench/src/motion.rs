@@ -124,6 +124,9 @@ fn measure(
     })
 }
 
+/// One run on the large panel: wall and CPU seconds, stage times, courses, the output's safety.
+type PanelRun = (f64, f64, towpath_nc::Timings, usize, towpath_nc::SafetyReport);
+
 /// Runs the benchmark.
 pub fn run(a: Args) -> anyhow::Result<()> {
     let base = Dialect { tow_width: Some(TOW_WIDTH), ..Dialect::default() };
@@ -165,6 +168,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         };
         parts.push((p, cell, level));
     }
+    let mut verdicts = Vec::new();
     for (p, cell, level) in &parts {
         let safety = Safety::new(&p.machine, &base, cell.clone(), SafetyOptions::default())?;
         let fixed = Dialect { clearance: Some(Clearance { axis: "Z".into(), value: *level }), ..base.clone() };
@@ -186,7 +190,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             eprint!("{row}");
             md.push_str(&row);
         }
+        verdicts.push(format!(
+            "{name}: planned {:+.1} % off-part time against straight, {:+.1} % against the fixed clearance, \
+             {} collisions",
+            100.0 * (planned.off_time - straight.off_time) / straight.off_time,
+            100.0 * (planned.off_time - clear.off_time) / clear.off_time,
+            planned.collisions
+        ));
     }
+    md.push_str(&format!(
+        "\nTargets: planned transits within 2 % of the unsafe straight ones where obstacles are few, clearly \
+         below a fixed clearance, and no collision in anything towpath writes. Measured: {}.\n",
+        verdicts.join("; ")
+    ));
 
     // The large panel on its tool.
     let text = stacked_panel(a.plies, a.courses);
@@ -209,7 +225,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         eprintln!("panel run {run}: {wall:.2} s wall, {cpu:.2} s CPU, {:?}", o.timings);
         rows.push((wall, cpu, o.timings.clone(), o.program.courses.len(), after));
     }
-    let m = |f: &dyn Fn(&(f64, f64, towpath_nc::Timings, usize, towpath_nc::SafetyReport)) -> f64| {
+    let m = |f: &dyn Fn(&PanelRun) -> f64| {
         median(&rows.iter().map(f).collect::<Vec<_>>())
     };
     let (courses, moves, coll) =

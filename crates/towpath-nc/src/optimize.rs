@@ -276,7 +276,11 @@ pub fn optimize(
                 let report = SafetyReport { limit_violations: outside, ..SafetyReport::default() };
                 return Err(NcError::Unsafe(format!(
                     "the program towpath would write leaves the travel limits ({}):\n{}",
-                    if input > 0 { format!("the input does too, on {input} lines") } else { "the input does not".into() },
+                    if input > 0 {
+                        format!("the input does too, on {input} lines")
+                    } else {
+                        "the input does not".into()
+                    },
                     report.details(5).join("\n")
                 )));
             }

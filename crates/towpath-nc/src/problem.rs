@@ -28,7 +28,7 @@ use crate::safety::Safety;
 pub enum AfpCost {
     /// One direct move (or up to the dialect's fixed clearance, across and down), priced by
     /// the machine's cost model.
-    Direct(MachineCost),
+    Direct(Box<MachineCost>),
     /// The transit the motion-safety planner plans against the cell (straight where that keeps
     /// the clearance, else lifted only as high as the obstacles need), each move priced by the
     /// machine's cost model; arcs with no safe transit are forbidden.
@@ -261,7 +261,7 @@ pub fn build_problem_with(
 
     let model = match safety {
         Some(s) => AfpCost::Planned(Arc::new(TransitCost::new(s.planner().clone(), cost.clone()))),
-        None => AfpCost::Direct(cost.clone()),
+        None => AfpCost::Direct(Box::new(cost.clone())),
     };
     let mut b = Problem::builder(model);
     for (c, ms) in modes.iter().enumerate() {

@@ -390,6 +390,14 @@ impl Report {
             }
         );
         let _ = writeln!(h, "<p>Course width: {}.</p>", esc(&self.width_line()));
+        if let Some(sf) = &self.safety {
+            let _ = writeln!(
+                h,
+                "<p class=\"safety-summary\"><b>Motion safety</b> against the cell: input: {}; output: {}.</p>",
+                esc(&sf.before.summary()),
+                esc(&sf.after.summary())
+            );
+        }
         for w in &self.warnings {
             let _ = writeln!(h, "<p><b>Warning:</b> {}</p>", esc(w));
         }

@@ -339,7 +339,8 @@ pub fn check_cell_under_path(
         .collect();
     towpath_motion::check_mandrel_radius(safety.checker().rig(), &laid, MIN_MANDREL_RADIUS)
         .map_err(|e| NcError::Request(e.to_string()))?;
-    towpath_motion::check_laid_points(safety.checker().cell(), &laid, max_gap).map_err(|e| NcError::Request(e.to_string()))
+    towpath_motion::check_laid_points(safety.checker().cell(), &laid, max_gap)
+        .map_err(|e| NcError::Request(e.to_string()))
 }
 
 /// Laid points closer than this to a mandrel's axis are refused, mm: a course cannot be laid

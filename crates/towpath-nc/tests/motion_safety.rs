@@ -220,5 +220,8 @@ fn a_course_laid_outside_the_travel_limits_is_refused() {
     let e = optimize(&p.program, &m, &dialect(), &opts(None)).unwrap_err();
     let text = e.to_string();
     assert!(matches!(e, NcError::Line { .. }), "{e}");
-    assert!(text.contains("is laid outside the travel limits: axis X at") && text.contains("outside [none, 1000]"), "{e}");
+    assert!(
+        text.contains("is laid outside the travel limits: axis X at") && text.contains("outside [none, 1000]"),
+        "{e}"
+    );
 }
