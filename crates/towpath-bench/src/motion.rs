@@ -225,9 +225,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         eprintln!("panel run {run}: {wall:.2} s wall, {cpu:.2} s CPU, {:?}", o.timings);
         rows.push((wall, cpu, o.timings.clone(), o.program.courses.len(), after));
     }
-    let m = |f: &dyn Fn(&PanelRun) -> f64| {
-        median(&rows.iter().map(f).collect::<Vec<_>>())
-    };
+    let m = |f: &dyn Fn(&PanelRun) -> f64| median(&rows.iter().map(f).collect::<Vec<_>>());
     let (courses, moves, coll) =
         rows.first().map_or((0, 0, 0), |r| (r.3, r.4.moves_checked, r.4.collisions.len() + r.4.limit_violations.len()));
     md.push_str(&format!(
