@@ -50,7 +50,7 @@ pub use reverse::{reversal_of, reverse_course, Irreversible, Reversed};
 pub use rewrite::{rewrite, rewrite_with, Placement};
 pub use safety::{
     check_cell_under_path, check_courses_within_limits, check_program, limit_violations, LimitIssue, MoveIssue, Safety,
-    SafetyOptions, SafetyReport, DEFAULT_CLEARANCE, MOLD_GAP,
+    SafetyOptions, SafetyReport, DEFAULT_CLEARANCE, MIN_MANDREL_RADIUS, MOLD_GAP,
 };
 pub use sequencer::{seed000_sets, sequence};
 pub use towpath_baselines::{BaselineParams, SolverName};
