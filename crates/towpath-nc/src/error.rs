@@ -37,6 +37,42 @@ pub enum NcError {
     /// The program needs a course width and none was given.
     #[error("{0}")]
     Width(String),
+    /// Precedence between plies needs course footprints, hence a width, and none was given (in
+    /// the options or the dialect). Front ends say how to give one (a command-line flag, a
+    /// request field) or to check ply by ply, which needs none.
+    #[error(
+        "the program has {plies} plies and {} between them needs course footprints, so a course or tow width, \
+         and none was given (neither in the options nor in the dialect); ply-by-ply precedence needs none",
+        if *.checking { "checking precedence" } else { "precedence" }
+    )]
+    NeedsWidth {
+        /// Plies that hold courses.
+        plies: usize,
+        /// True when the verifier needs it (false: the optimizer).
+        checking: bool,
+    },
+    /// A tow width was given but a course restarts no tows, so it has no width by tows: a
+    /// course width is needed.
+    #[error(
+        "line {line}: this course restarts no tows, so a tow width cannot give its width: a course width is needed"
+    )]
+    TowWidthWithoutTows {
+        /// 1-based line where the course's on-part block starts.
+        line: usize,
+    },
+    /// Course footprints need the tool point, and the machine has no kinematics.
+    #[error(
+        "course footprints need the tool point: give the machine a DH chain or X/Y/Z linear axes (ply-by-ply \
+         precedence needs no footprints)"
+    )]
+    NoToolPoint,
+    /// Doherty et al.'s solver orders every precedence set freely, so it cannot keep the order of the
+    /// courses within each ply.
+    #[error(
+        "doherty cannot keep the order of the courses within each ply: Doherty et al.'s solver orders every \
+         precedence set freely"
+    )]
+    DohertyKeepsNoPlyOrder,
     /// The course width cannot be right for this program: narrower than the overlap tolerance
     /// (footprints would vanish) or far wider than the whole laid part (most likely a width in
     /// other units).

@@ -300,21 +300,12 @@ pub(crate) fn footprints_within(
             ),
         });
     }
-    let kin = machine.kinematics().ok_or_else(|| {
-        NcError::Machine(
-            "course footprints need the tool point: give the machine a DH chain or X/Y/Z linear axes \
-             (or use --precedence plies, which needs no footprints)"
-                .into(),
-        )
-    })?;
+    let kin = machine.kinematics().ok_or(NcError::NoToolPoint)?;
     for course in &program.courses {
         let segs = &program.segments[course.segments.clone()];
         let has_tows = segs.iter().any(|s| s.on_part && s.mask != 0);
         if !has_tows && matches!(width, Width::Tow(_)) && segs.iter().any(|s| s.on_part) {
-            return Err(NcError::Width(format!(
-                "line {}: this course restarts no tows, so a tow width cannot give its width: use --course-width",
-                course.on_part.start + 1
-            )));
+            return Err(NcError::TowWidthWithoutTows { line: course.on_part.start + 1 });
         }
     }
     let frame = frame_for(program, machine, &kin, Some(width))?;

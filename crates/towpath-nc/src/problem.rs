@@ -202,13 +202,7 @@ pub fn build_problem_with(
     let width = opts.width_or(dialect);
     let needs_fp = plies_with_courses > 1 && opts.precedence != PrecedenceRule::Plies;
     let fps = match (needs_fp, width) {
-        (true, None) => {
-            return Err(NcError::Width(format!(
-                "the program has {plies_with_courses} plies and precedence between them needs course footprints: \
-                 give --tow-width MM or --course-width MM (or tow_width / course_width in the dialect), \
-                 or use --precedence plies"
-            )))
-        }
+        (true, None) => return Err(NcError::NeedsWidth { plies: plies_with_courses, checking: false }),
         (true, Some(w)) => Some(footprints(program, machine, w)?),
         (false, Some(w)) if machine.kinematics().is_some() => footprints(program, machine, w).ok(),
         _ => None,

@@ -26,11 +26,7 @@ use crate::program::Program;
 /// solver orders each set freely), so it is refused.
 pub fn seed000_sets(program: &Program, afp: &AfpProblem, opts: &AfpOptions) -> Result<Vec<PrecedenceSet>, NcError> {
     if opts.keep_ply_order {
-        return Err(NcError::Solver(
-            "doherty cannot keep the order of the courses within each ply: Doherty et al.'s solver orders every \
-             precedence set freely (drop --keep-ply-order, or use another solver)"
-                .into(),
-        ));
+        return Err(NcError::DohertyKeepsNoPlyOrder);
     }
     let tasks = |courses: &[usize]| courses.iter().map(|&c| TaskId(c as u32)).collect::<Vec<_>>();
     let sets = match opts.precedence {

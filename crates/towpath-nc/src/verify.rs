@@ -223,12 +223,8 @@ pub fn verify_parsed(
                 &owned
             }
             (None, None) => {
-                return Err(VerifyError::Setup(NcError::Width(
-                    "checking precedence between plies needs course footprints: give --tow-width MM or \
-                     --course-width MM (or tow_width / course_width in the dialect), or check ply by ply \
-                     (--precedence plies), which needs none"
-                        .into(),
-                )))
+                let plies = orig.plies.iter().filter(|p| !p.courses.is_empty()).count();
+                return Err(VerifyError::Setup(NcError::NeedsWidth { plies, checking: true }));
             }
         };
         check_precedence(orig, fps, &order)?;

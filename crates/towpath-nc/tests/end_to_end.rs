@@ -122,7 +122,7 @@ fn doherty_refuses_to_keep_the_ply_order() {
         ..OptimizeOptions::default()
     };
     match optimize(&part.program, &part.machine, &d, &opts) {
-        Err(NcError::Solver(m)) => assert!(m.contains("keep-ply-order"), "{m}"),
+        Err(e @ NcError::DohertyKeepsNoPlyOrder) => assert!(e.to_string().contains("within each ply"), "{e}"),
         other => panic!("expected a solver error, got {:?}", other.map(|o| o.solver)),
     }
 }

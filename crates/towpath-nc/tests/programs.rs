@@ -236,8 +236,9 @@ fn precedence_needs_a_width_and_says_so() {
     let d = Dialect::default();
     let p = parse(&program(), &gantry(), &d).unwrap();
     let e = build_problem(&p, &gantry(), &d, &AfpOptions::default()).unwrap_err();
-    assert!(matches!(e, NcError::Width(_)), "{e}");
-    assert!(e.to_string().contains("--tow-width"), "{e}");
+    assert!(matches!(e, NcError::NeedsWidth { plies: 2, checking: false }), "{e}");
+    assert!(e.to_string().contains("needs course footprints, so a course or tow width"), "{e}");
+    assert!(!e.to_string().contains("--"), "the library names no command-line flag: {e}");
     // Ply-by-ply precedence needs none.
     let o = AfpOptions { precedence: PrecedenceRule::Plies, ..AfpOptions::default() };
     build_problem(&p, &gantry(), &d, &o).unwrap();

@@ -81,10 +81,20 @@ fn positive(name: &str, w: f64) -> anyhow::Result<f64> {
     }
 }
 
-/// Says where the machine file sets what a library error points at (the mandrel's axis for
-/// a tool point on or near it), so the message names the file to fix as well as the program.
-pub fn machine_hint(e: &NcError, machine: &Path) -> String {
+/// What the user can do about a library error, in this command line's terms: the flag that
+/// gives what is missing, or where the machine file sets what the error points at (the
+/// mandrel's axis for a tool point on or near it), so the message names the file to fix as
+/// well as the program. The libraries' messages name no flags.
+pub fn hint(e: &NcError, machine: &Path) -> String {
     match e {
+        NcError::NeedsWidth { .. } => {
+            " (give --tow-width MM or --course-width MM, or tow_width / course_width in the dialect; or use \
+             --precedence plies)"
+                .into()
+        }
+        NcError::TowWidthWithoutTows { .. } => " (give --course-width MM)".into(),
+        NcError::NoToolPoint => " (or use --precedence plies)".into(),
+        NcError::DohertyKeepsNoPlyOrder => " (drop --keep-ply-order, or choose another --solver)".into(),
         NcError::MandrelAxis { axis, label, .. } => format!(
             " (they are `origin` and `direction` of axis {label}, the [[axis]] table number {} in {})",
             axis + 1,

@@ -7,7 +7,7 @@ use std::time::Duration;
 use towpath_machine::CostKind;
 use towpath_nc::{optimize, AfpOptions, NcError, OptimizeOptions, PrecedenceRule, Report};
 
-use super::afp_common::{lines_with, machine_hint, read, warn, width_from, CellArgs, MachineArgs};
+use super::afp_common::{hint, lines_with, read, warn, width_from, CellArgs, MachineArgs};
 use super::solver_args::SolverArgs;
 use crate::files::Files;
 use crate::{exit, outln};
@@ -67,7 +67,7 @@ pub struct Args {
 /// Maps an optimization error to an exit code, naming the program file (and the machine file
 /// where the error lies in it).
 pub fn classify(file: &std::path::Path, machine: &std::path::Path, e: NcError) -> anyhow::Error {
-    let hint = machine_hint(&e, machine);
+    let hint = hint(&e, machine);
     match e {
         NcError::SelfCheck(_) | NcError::Unsafe(_) => exit::check_failed(anyhow::anyhow!("{}: {e}", file.display())),
         // Everything else, a solver that cannot take this program (`NcError::Solver`) included,

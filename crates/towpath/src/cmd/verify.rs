@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use towpath_nc::{totals, verify, PrecedenceRule, VerifyError, VerifyOptions};
 
-use super::afp_common::{machine_hint, read, warn, width_from, CellArgs, MachineArgs};
+use super::afp_common::{hint, read, warn, width_from, CellArgs, MachineArgs};
 use crate::{exit, outln};
 
 /// Arguments of `towpath verify`.
@@ -51,15 +51,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let m = &args.machine.machine;
     let v = verify(&original, &optimized, &machine, &dialect, &opts).map_err(|e| match e {
-        VerifyError::Original(e) => {
-            exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.original.display(), machine_hint(&e, m)))
-        }
+        VerifyError::Original(e) => exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.original.display(), hint(&e, m))),
         VerifyError::Optimized(e) => {
-            exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.optimized.display(), machine_hint(&e, m)))
+            exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.optimized.display(), hint(&e, m)))
         }
-        VerifyError::Setup(e) => {
-            exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.original.display(), machine_hint(&e, m)))
-        }
+        VerifyError::Setup(e) => exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.original.display(), hint(&e, m))),
         e => {
             exit::check_failed(anyhow::anyhow!("{} against {}: {e}", args.optimized.display(), args.original.display()))
         }
