@@ -1,8 +1,6 @@
 //! Hand-written programs: round trips, optimization, the verifier catching broken programs,
 //! and bad input refused with the line named.
 
-use std::time::Duration;
-
 use towpath_machine::{Axis, AxisKind, CostKind, Machine};
 use towpath_nc::{
     build_problem, optimize, parse, reverse_course, rewrite, verify, AfpOptions, Dialect, NcError, OptimizeOptions,
@@ -49,7 +47,9 @@ fn program() -> String {
 fn opts(bidirectional: bool) -> OptimizeOptions {
     OptimizeOptions {
         afp: AfpOptions { bidirectional, width: Some(Width::Tow(10.0)), ..AfpOptions::for_machine(&gantry()) },
-        time_limit: Some(Duration::from_millis(200)),
+        // A work budget, not a time limit: the result depends only on the inputs.
+        time_limit: None,
+        iterations: Some(300),
         threads: 1,
         ..OptimizeOptions::default()
     }

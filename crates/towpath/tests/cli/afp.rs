@@ -29,7 +29,7 @@ fn demo_optimize_verify_round() {
         .arg(d.join("gantry-afp.toml"))
         .arg("--dialect")
         .arg(d.join("dialect.toml"))
-        .args(["--bidirectional", "--cost", "time", "--time-limit", "0.2", "--json", "-o"])
+        .args(["--bidirectional", "--cost", "time", "--iterations", "300", "--json", "-o"])
         .arg(&out)
         .arg("--report")
         .arg(&report));

@@ -1,8 +1,6 @@
-//! Issue 3 ("AFP programs end to end"), bullet by bullet: the details the other test files do not
-//! show on their own. Each test checks an outcome against an independent reading of the
+//! AFP programs end to end, detail by detail (course footprints, reversal, rewriting, the
+//! verifier's refusals, the report): what the other test files do not show on their own. Each test checks an outcome against an independent reading of the
 //! program (its own text, its own geometry), not against a stored answer.
-
-use std::time::Duration;
 
 use towpath_machine::{Axis, AxisKind, CostKind, Machine};
 use towpath_nc::{
@@ -64,7 +62,9 @@ fn program() -> String {
 fn opts(bidirectional: bool) -> OptimizeOptions {
     OptimizeOptions {
         afp: AfpOptions { bidirectional, width: Some(Width::Tow(10.0)), ..AfpOptions::for_machine(&gantry()) },
-        time_limit: Some(Duration::from_millis(200)),
+        // A work budget, not a time limit: the result depends only on the inputs.
+        time_limit: None,
+        iterations: Some(300),
         threads: 1,
         ..OptimizeOptions::default()
     }
