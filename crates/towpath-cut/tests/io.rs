@@ -263,6 +263,23 @@ fn json_round_trip_with_hierarchy() {
     assert_eq!(ids, ["mark1", "mark2", "part", "sheet"]);
 }
 
+/// Two pieces that touch, with no torch/pen line between them in the order written: the rapid
+/// between them is written although it does not move, so they are read back as two pieces
+/// (a case `gcode_from_random_moves_round_trips` found).
+#[test]
+fn touching_pieces_stay_apart_when_written() {
+    let g = "G90\nG0 X8 Y-31\nG1 X0 Y-1\nM5\nG1 X0 Y0\nG0 X0 Y1\nG0 X0 Y0\n";
+    for start in [None, Some([0.0, 0.0]), Some([8.0, -31.0])] {
+        let (d, src) = read(Format::Gcode, g, "p.nc", 1e-4).unwrap();
+        assert_eq!(d.pieces.len(), 2);
+        let o = OrderOptions { start, ..opts() };
+        let r = order(&d, &o).unwrap();
+        let out = write(&src, &d, &r.placements).unwrap();
+        let (back, _) = read(Format::Gcode, &out, "o.nc", 1e-4).unwrap();
+        assert_eq!(back.pieces.len(), 2, "{out}");
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
 

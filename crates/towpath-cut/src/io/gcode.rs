@@ -15,7 +15,8 @@
 //! arcs whose centre is not equidistant from their ends.
 //!
 //! **Writing.** Header; for each piece in the new order one rapid `G0 X.. Y..` to its entry
-//! (none when the piece starts exactly where the one before ended),
+//! (none when the piece starts exactly where the one before ended and a torch/pen line between
+//! them keeps them apart),
 //! its plunge lines, its lead-in (feed moves), its moves (the original lines if it is done as
 //! written, else regenerated as G1/G2/G3 with the feed that was in effect), its retract lines;
 //! then the footer. Every other line is kept as written.
@@ -37,6 +38,10 @@ struct Block {
     /// Motion mode in effect where the prefix starts, if not G0.
     prefix_mode: Option<String>,
     original: Path,
+    /// The prefix holds a line that ends a piece (torch/pen on or off, a rapid without X/Y).
+    prefix_breaks: bool,
+    /// The suffix holds such a line.
+    suffix_breaks: bool,
 }
 
 /// What the G-code writer keeps of the input.
@@ -311,7 +316,10 @@ pub fn read(text: &str, name: &str) -> Result<(Drawing, GcodeSource), CutError> 
             _ => Motion::Line,
         };
         let _ = mode_before;
+        let breaks = |k: &usize| matches!(kinds[*k], Kind::Break);
         blocks.push(Block {
+            prefix_breaks: (prefix_start.min(a)..a).any(|k| breaks(&k)),
+            suffix_breaks: (b + 1..suffix_end.max(b + 1)).any(|k| breaks(&k)) || middle.iter().any(breaks),
             prefix: owned(prefix_start.min(a), a),
             motion: owned(a, b + 1),
             suffix: {
@@ -420,16 +428,19 @@ fn moves(path: &Path, feed: Option<&str>, out: &mut Vec<String>) {
 /// Writes an ordering as G-code.
 pub fn write(source: &GcodeSource, _drawing: &Drawing, order: &[Placement]) -> String {
     let mut out: Vec<String> = source.header.clone();
-    // Where the previous piece ended: a piece that starts exactly there (strokes joined by
-    // `--merge`) needs no rapid, a move to where the tool already is.
-    let mut at: Option<[f64; 2]> = None;
+    // Where the previous piece ended, and whether its last lines end a piece: a piece that
+    // starts exactly there needs no rapid (a move to where the tool already is) when a line
+    // between them (torch off, pen up, ...) keeps the two pieces apart; without one the rapid
+    // is what separates them, so it is written even though it does not move.
+    let mut at: Option<([f64; 2], bool)> = None;
     for pl in order {
         let Some(b) = source.blocks.get(pl.piece) else { continue };
         let e = pl.entry();
-        if pl.lead_in.is_some() || at != Some(e) {
+        let joined = at.is_some_and(|(p, broken)| p == e && (broken || b.prefix_breaks));
+        if pl.lead_in.is_some() || !joined {
             out.push(format!("G0 X{} Y{}", fmt(e[0]), fmt(e[1])));
         }
-        at = Some(pl.path.end());
+        at = Some((pl.path.end(), b.suffix_breaks));
         if let Some(m) = &b.prefix_mode {
             out.push(m.clone());
         }
