@@ -236,6 +236,17 @@ pub fn follow_up(dir: &Path) -> Vec<String> {
             "  {bin} optimize {program} --machine {machine} --dialect {dialect} \\\n    --bidirectional -o {out} --report {report}"
         ),
         format!("  {bin} verify {program} {out} --machine {machine} --dialect {dialect}"),
+        "  # A part in a cell: its transits planned over the stringer, every move checked against the meshes.".to_string(),
+        format!(
+            "  {bin} optimize {} --machine {machine} --dialect {dialect} \\\n    --mold {} --mold {} --mold {} \\\n    \
+             --bidirectional -o {} --report {}",
+            q(dir.join("planar-stringer.nc")),
+            q(dir.join("planar-stringer.tool.stl")),
+            q(dir.join("planar-stringer.stringer.stl")),
+            q(dir.join("planar-stringer.clamp.stl")),
+            q(dir.join("planar-stringer.mine.nc")),
+            q(dir.join("planar-stringer.mine.html")),
+        ),
     ]
 }
 

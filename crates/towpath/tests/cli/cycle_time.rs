@@ -164,6 +164,8 @@ fn demo_follow_up_commands_work_as_pasted() {
         assert_eq!(code, 0, "{script}\n{sh_out}\n{sh_err}");
         assert!(sh_out.contains("verified: 49 courses"), "{sh_out}");
         assert!(here.join("my demo/planar-45.mine.nc").exists() && here.join("my demo/planar-45.mine.html").exists());
+        assert!(sh_out.contains("motion safety, output: 0 collisions"), "{sh_out}");
+        assert!(here.join("my demo/planar-stringer.mine.nc").exists());
         let beside: Vec<_> = std::fs::read_dir(&here).unwrap().map(|e| e.unwrap().file_name()).collect();
         assert_eq!(beside, vec![std::ffi::OsString::from("my demo")], "nothing written beside the demo folder");
         let _ = std::fs::remove_dir_all(&here);
