@@ -393,6 +393,8 @@ pub struct PlySaving {
 
 /// The outcome of an optimization.
 pub struct OptimizeOutcome {
+    /// The cost model optimized (`auto` resolved against the machine): `axis`, `time` or `tool`.
+    pub cost: String,
     /// The optimized program.
     pub text: String,
     /// New order: (original course, reversed).
@@ -584,6 +586,7 @@ pub fn optimize(
         }
     );
     Ok(OptimizeOutcome {
+        cost: checked.afp.cost.name().to_string(),
         order: o.order.iter().map(|p| (p.course, p.reversed)).collect(),
         reversed: o.verification.reversed,
         text: o.text,

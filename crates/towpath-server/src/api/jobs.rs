@@ -128,13 +128,13 @@ pub async fn optimize(
             "fell_back": out.fell_back,
             "solver_cost": [out.solver_cost.0, out.solver_cost.1],
             "reversed": out.reversed,
-            "cost": req.cost,
+            "cost": out.cost,
             "download_name": format!("{stem}-optimized.nc"),
         });
         let pmeta = ProgramMeta {
             machine: meta.machine.clone(),
             dialect: meta.dialect.clone(),
-            description: format!("{program_id} optimized ({})", req.cost),
+            description: format!("{program_id} optimized ({})", out.cost),
             original: Some(program_id.clone()),
             order: Some(out.order.clone()),
             job: Some(job_id),
