@@ -225,3 +225,24 @@ fn a_course_laid_outside_the_travel_limits_is_refused() {
         "{e}"
     );
 }
+
+/// The machine file's `[head]` capsule is checked like the tool point: a head 30 mm in radius
+/// standing over the last course before the stringer reaches into it, which the tool point
+/// alone never does, and the optimizer will not write such a program.
+#[test]
+fn the_head_of_the_machine_file_is_checked_too() {
+    let p = part("planar-stringer");
+    let d = dialect();
+    let mut m = p.machine.clone();
+    m.head = Some(towpath_machine::Head { radius: 30.0, bottom: 30.0, top: 225.0 });
+    m.validate().unwrap();
+    let s = Safety::new(&m, &d, cell_of(&p), SafetyOptions::default()).unwrap();
+    let r = check_program(&parse(&p.program, &m, &d).unwrap(), &s);
+    let head: Vec<_> = r.collisions.iter().filter(|c| c.body == "head").collect();
+    assert!(!head.is_empty(), "{}", r.summary());
+    // Without the head, the same program's only collisions are its two transits through the stringer.
+    let bare = check_program(&parse(&p.program, &p.machine, &d).unwrap(), &safety(&p));
+    assert!(bare.collisions.iter().all(|c| c.body == "tool") && bare.collisions.len() < r.collisions.len());
+    let e = optimize(&p.program, &m, &d, &OptimizeOptions { iterations: Some(50), ..opts(Some(s)) }).unwrap_err();
+    assert!(matches!(e, NcError::Unsafe(_)), "{e}");
+}
