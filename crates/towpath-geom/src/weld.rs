@@ -40,8 +40,12 @@ pub fn weld(positions: &[DVec3], tol: f64) -> (Vec<DVec3>, Vec<u32>) {
         return (reps, first_map.into_iter().map(|i| m2[i as usize]).collect());
     }
     // Cells four tolerances wide: a point needs the neighbouring cell along an axis only within
-    // one tolerance (a quarter cell) of that face.
-    let inv = 1.0 / (4.0 * tol);
+    // one tolerance (a quarter cell) of that face. Cells are never narrower than 2⁻⁴⁰ of the
+    // largest coordinate, so that cell indices stay far inside i64 whatever the tolerance (a
+    // tolerance below that welds only points closer than it anyway: wider cells change which
+    // cells are searched, not which points weld).
+    let scale = positions.iter().map(|p| p.abs().max_element()).filter(|m| m.is_finite()).fold(0.0, f64::max);
+    let inv = 1.0 / (4.0 * tol).max(scale * 2f64.powi(-40));
     let tol2 = tol * tol;
     // Cell -> first representative in it; `next` chains representatives of the same cell.
     let mut heads: HashMap<[i64; 3], u32, BuildHasherDefault<MixHasher>> = HashMap::default();
@@ -151,6 +155,26 @@ mod tests {
         let pts = [DVec3::new(-1e-9, 3.0, 3.0), DVec3::new(1e-9, 3.0, 3.0)];
         let (_, map) = weld(&pts, 1e-6);
         assert_eq!(map, vec![0, 0]);
+    }
+
+    /// A tolerance far below the coordinates' resolution (`--weld-tolerance 1e-300`, found by
+    /// the command-line fuzzer) neither overflows the grid nor welds distinct points; points
+    /// within it still weld, as do points within a tolerance near 2⁻⁴⁰ of the coordinates.
+    #[test]
+    fn tiny_tolerances_keep_the_grid_in_range() {
+        let pts = [
+            DVec3::new(100.0, -50.0, 200.0),
+            DVec3::new(100.0 + 1e-9, -50.0, 200.0),
+            DVec3::new(-100.0, 50.0, 0.0),
+            DVec3::new(100.0, -50.0, 200.0 + 1e-13),
+        ];
+        for tol in [1e-300, f64::MIN_POSITIVE, 1e-200] {
+            let (reps, map) = weld(&pts, tol);
+            assert_eq!(map, vec![0, 1, 2, 3], "{tol}");
+            assert_eq!(reps.len(), 4);
+        }
+        let (_, map) = weld(&pts, 1e-12);
+        assert_eq!(map, vec![0, 1, 2, 0]);
     }
 
     #[test]
