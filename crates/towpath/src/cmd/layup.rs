@@ -11,19 +11,19 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Context};
-use towpath_geom::surface::{Analytic, Nurbs, Tessellation};
+use towpath_geom::surface::Tessellation;
 use towpath_geom::{io, DVec3};
 use towpath_layup::input::{read_curve, read_orientations};
 use towpath_layup::output::{self, Meta, Post};
 use towpath_layup::ply::Method;
 use towpath_layup::request::{
-    self as layup, sig, DirectionSource, LayupError, LayupRequest, LayupResult, Limits, SurfaceRequest, SurfaceSource,
-    Warning,
+    self as layup, sig, DirectionSource, LayupError, LayupRequest, LayupResult, Limits, SurfaceRequest, Warning,
 };
 use towpath_layup::section::Coverage;
 use towpath_layup::units::Units;
 
 use super::layup_report;
+use super::surface_arg::surface_source;
 use crate::files::Files;
 use crate::{exit, outln};
 
@@ -170,23 +170,6 @@ fn parse_vec3(s: &str) -> Result<DVec3, String> {
         }
     }
     Ok(DVec3::from(v))
-}
-
-/// Reads the surface argument: a mesh file's triangles, or an analytic or NURBS surface to be
-/// tessellated by the request.
-fn surface_source(text: &str) -> anyhow::Result<SurfaceSource> {
-    let kind = text.split(':').next().unwrap_or("");
-    Ok(match kind {
-        "plane" | "cylinder" | "cone" | "sphere" if text.contains(':') => {
-            SurfaceSource::Analytic(Analytic::parse(text).map_err(exit::bad_input)?)
-        }
-        "nurbs" if text.contains(':') => {
-            let path = &text["nurbs:".len()..];
-            let json = read_text(Path::new(path))?;
-            SurfaceSource::Nurbs(Nurbs::from_json(&json).map_err(|e| exit::bad_input(anyhow!("{path}: {e}")))?)
-        }
-        _ => SurfaceSource::Soup(io::read_path(Path::new(text)).map_err(exit::bad_input)?),
-    })
 }
 
 fn read_text(path: &Path) -> anyhow::Result<String> {

@@ -13,4 +13,5 @@ pub mod serve;
 pub mod solve;
 pub mod solver_args;
 pub mod spray;
+mod surface_arg;
 pub mod verify;

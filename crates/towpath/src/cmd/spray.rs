@@ -5,13 +5,14 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{anyhow, Context};
-use towpath_geom::surface::{tessellate, tessellate_analytic, Analytic, Nurbs, Tessellation};
-use towpath_geom::{io, BuildOptions, DVec3, Mesh, RepairReport, Soup};
+use anyhow::anyhow;
+use towpath_geom::surface::Tessellation;
+use towpath_geom::{BuildOptions, DVec3, Mesh, RepairReport};
 use towpath_spray::output::{self, Meta};
 use towpath_spray::{Gun, PatternChoice, Profile, SeqOptions, SprayError, SprayParams, ThicknessMap};
 
 use crate::cmd::solver_args::{time_limit, SolverArgs};
+use crate::cmd::surface_arg::{soup_of, surface_source};
 use crate::files::Files;
 use crate::{exit, outln};
 
@@ -153,25 +154,10 @@ struct LoadedSurface {
     report: RepairReport,
 }
 
-/// Reads a mesh file or tessellates an analytic description / NURBS patch, then welds it.
+/// Reads a mesh file or tessellates an analytic description / NURBS patch (as `layup` does),
+/// then welds it.
 fn load_surface(text: &str, tess: Tessellation, weld_tolerance: Option<f64>) -> anyhow::Result<LoadedSurface> {
-    let kind = text.split(':').next().unwrap_or("");
-    let soup: Soup = match kind {
-        "plane" | "cylinder" | "cone" | "sphere" if text.contains(':') => {
-            let s = Analytic::parse(text).map_err(exit::bad_input)?;
-            tessellate_analytic(&s, &tess).map_err(exit::bad_input)?
-        }
-        "nurbs" if text.contains(':') => {
-            let path = &text["nurbs:".len()..];
-            let bytes = std::fs::read(path).with_context(|| format!("{path}: cannot read")).map_err(exit::bad_input)?;
-            let n: Nurbs = serde_json::from_slice(&bytes)
-                .map_err(|e| anyhow!("{path}: not a NURBS patch: {e}"))
-                .map_err(exit::bad_input)?;
-            n.validate().map_err(|e| exit::bad_input(anyhow!("{path}: {e}")))?;
-            tessellate(&n, &tess).map_err(exit::bad_input)?
-        }
-        _ => io::read_path(Path::new(text)).map_err(exit::bad_input)?,
-    };
+    let soup = soup_of(surface_source(text)?, &tess)?;
     let (mesh, report) = Mesh::build(&soup, &BuildOptions { weld_tolerance, ..BuildOptions::default() })
         .map_err(|e| exit::bad_input(anyhow!("{text}: {e}")))?;
     Ok(LoadedSurface { mesh, report })
