@@ -9,7 +9,7 @@ use std::time::Duration;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use towpath_baselines::*;
-use towpath_coverage::{seed004_like, RppModel};
+use towpath_coverage::{tewolde_sheng_like, RppModel};
 use towpath_seq::*;
 
 /// Options that make every solver deterministic: a work budget, no time limit, one thread.
@@ -164,7 +164,7 @@ fn seed004_small_instances_are_solved_optimally_by_ga_and_aco() {
     let mut total = 0;
     for r in [3usize, 4, 5] {
         for seed in 1..=8u64 {
-            let model = RppModel::new(seed004_like(r, seed).unwrap()).unwrap();
+            let model = RppModel::new(tewolde_sheng_like(r, seed).unwrap()).unwrap();
             let p = model.problem();
             let exact = solve_exact(p).unwrap().unwrap().cost;
             total += 1;
@@ -217,7 +217,7 @@ fn deterministic_solvers_are_repeatable_bit_for_bit() {
 #[test]
 fn randomized_solvers_depend_on_the_seed() {
     // On a 30-edge instance different seeds give different GA and ACO runs.
-    let model = RppModel::new(seed004_like(30, 2).unwrap()).unwrap();
+    let model = RppModel::new(tewolde_sheng_like(30, 2).unwrap()).unwrap();
     let params = BaselineParams::default();
     for name in [SolverName::Ga, SolverName::Aco1, SolverName::Aco2] {
         let runs: Vec<Vec<Step>> =
@@ -229,7 +229,7 @@ fn randomized_solvers_depend_on_the_seed() {
 #[test]
 fn an_initial_route_is_never_made_worse() {
     // seed 000 requirement 4: F(p) ≤ F(o), for every solver.
-    let model = RppModel::new(seed004_like(12, 9).unwrap()).unwrap();
+    let model = RppModel::new(tewolde_sheng_like(12, 9).unwrap()).unwrap();
     let p = model.problem();
     let best = solve(p, &SolveOptions { time_limit: Some(Duration::from_millis(300)), ..det_opts(1) }).unwrap();
     let params = BaselineParams {
@@ -246,7 +246,7 @@ fn an_initial_route_is_never_made_worse() {
 
 #[test]
 fn time_limit_is_honoured() {
-    let model = RppModel::new(seed004_like(40, 1).unwrap()).unwrap();
+    let model = RppModel::new(tewolde_sheng_like(40, 1).unwrap()).unwrap();
     let params = BaselineParams {
         ga: GaParams { generations: 1_000_000, ..GaParams::default() },
         aco: AcoParams { cycles: 1_000_000, ..AcoParams::default() },

@@ -28,14 +28,14 @@ use crate::paths::connected_components;
 pub const TABLE_I_SIZES: [(usize, usize); 10] =
     [(6, 3), (10, 5), (20, 10), (30, 15), (40, 20), (50, 25), (60, 30), (64, 32), (70, 35), (80, 40)];
 
-/// The most required edges [`seed004_like`] generates: the largest instance whose sequencing
+/// The most required edges [`tewolde_sheng_like`] generates: the largest instance whose sequencing
 /// model fits [`crate::MODEL_MAX_BYTES`] (2R terminals over 2R vertices).
 pub const MAX_GENERATED_REQUIRED: usize = 5000;
 
 /// Side of a patch cell, metres.
 const CELL: f64 = 2.0;
 
-/// A size [`seed004_like`] does not generate.
+/// A size [`tewolde_sheng_like`] does not generate.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum GenerateError {
     /// No required edge asked for.
@@ -51,7 +51,7 @@ pub enum GenerateError {
 
 /// Generates an instance with `required` required edges and `2 * required` vertices (see the
 /// module docs), from 1 to [`MAX_GENERATED_REQUIRED`] required edges.
-pub fn seed004_like(required: usize, seed: u64) -> Result<Instance, GenerateError> {
+pub fn tewolde_sheng_like(required: usize, seed: u64) -> Result<Instance, GenerateError> {
     if required == 0 {
         return Err(GenerateError::Empty);
     }
@@ -235,7 +235,7 @@ mod tests {
     #[test]
     fn shapes_match_table_i() {
         for (v, r) in TABLE_I_SIZES {
-            let i = seed004_like(r, 1).unwrap();
+            let i = tewolde_sheng_like(r, 1).unwrap();
             assert_eq!(i.vertices().len(), v);
             assert_eq!(i.required().len(), r);
             // every vertex is an end of exactly one required edge
@@ -251,19 +251,19 @@ mod tests {
             assert!(comp.iter().all(|&c| c == comp[0]));
         }
         // data set #1 of the paper has 10 edges for 6 vertices; ours is of that order
-        let e = seed004_like(3, 1).unwrap().edges().len();
+        let e = tewolde_sheng_like(3, 1).unwrap().edges().len();
         assert!((6..=14).contains(&e), "{e} edges");
     }
 
     #[test]
     fn deterministic_by_seed() {
-        assert_eq!(seed004_like(20, 5), seed004_like(20, 5));
-        assert_ne!(seed004_like(20, 5), seed004_like(20, 6));
+        assert_eq!(tewolde_sheng_like(20, 5), tewolde_sheng_like(20, 5));
+        assert_ne!(tewolde_sheng_like(20, 5), tewolde_sheng_like(20, 6));
     }
 
     /// The generator as first written: every pair scanned (O(n²) per join). The fast one must
     /// give exactly its instances.
-    fn seed004_like_by_scanning(r: usize, seed: u64) -> Instance {
+    fn tewolde_sheng_like_by_scanning(r: usize, seed: u64) -> Instance {
         let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x5EED_0004_u64.wrapping_mul(r as u64 + 1));
         let cols = (r as f64).sqrt().ceil() as usize;
         let mut vertices = Vec::new();
@@ -325,20 +325,24 @@ mod tests {
     fn same_instances_as_scanning_every_pair() {
         for (r, seeds) in [(1, 0..6u64), (2, 0..6), (3, 0..6), (7, 0..6), (40, 0..6), (150, 0..2), (400, 0..1)] {
             for seed in seeds {
-                assert_eq!(seed004_like(r, seed).unwrap(), seed004_like_by_scanning(r, seed), "r {r} seed {seed}");
+                assert_eq!(
+                    tewolde_sheng_like(r, seed).unwrap(),
+                    tewolde_sheng_like_by_scanning(r, seed),
+                    "r {r} seed {seed}"
+                );
             }
         }
     }
 
     #[test]
     fn sizes_are_bounded() {
-        assert_eq!(seed004_like(0, 1), Err(GenerateError::Empty));
-        assert_eq!(seed004_like(4_294_967_296, 1), Err(GenerateError::TooLarge(4_294_967_296)));
+        assert_eq!(tewolde_sheng_like(0, 1), Err(GenerateError::Empty));
+        assert_eq!(tewolde_sheng_like(4_294_967_296, 1), Err(GenerateError::TooLarge(4_294_967_296)));
         assert_eq!(
-            seed004_like(MAX_GENERATED_REQUIRED + 1, 1),
+            tewolde_sheng_like(MAX_GENERATED_REQUIRED + 1, 1),
             Err(GenerateError::TooLarge(MAX_GENERATED_REQUIRED + 1))
         );
-        let i = seed004_like(MAX_GENERATED_REQUIRED, 1).unwrap();
+        let i = tewolde_sheng_like(MAX_GENERATED_REQUIRED, 1).unwrap();
         assert_eq!(i.required().len(), MAX_GENERATED_REQUIRED);
     }
 }

@@ -15,7 +15,7 @@
 //!   checks a walk independently.
 //! - [`read_instance`] / [`write_instance`] / [`RouteJson`]: the JSON format, with errors that
 //!   name line and column.
-//! - [`seed004_like`]: instances shaped like the paper's Table I sample data.
+//! - [`tewolde_sheng_like`]: instances shaped like the paper's Table I sample data.
 //!
 //! This crate knows no CLI; its only IO-adjacent part is the JSON text format of its own data.
 
@@ -27,7 +27,7 @@ mod json;
 mod model;
 mod paths;
 
-pub use generate::{seed004_like, GenerateError, MAX_GENERATED_REQUIRED, TABLE_I_SIZES};
+pub use generate::{tewolde_sheng_like, GenerateError, MAX_GENERATED_REQUIRED, TABLE_I_SIZES};
 pub use instance::{Edge, Instance, InstanceError, InstanceErrorKind, Item};
 pub use json::{read_instance, write_instance, ReadError, ReadErrorKind, RouteJson, ServiceJson, FORMAT, ROUTE_FORMAT};
 pub use model::{

@@ -430,7 +430,7 @@ mod tests {
 
     #[test]
     fn shortest_paths_stop_at_the_time_limit_and_say_what_they_need() {
-        let i = crate::seed004_like(600, 1).unwrap();
+        let i = crate::tewolde_sheng_like(600, 1).unwrap();
         // No time at all: stopped after the first search of each thread.
         let clock = Clock::start(Some(std::time::Duration::ZERO), None);
         let e = RppModel::build(i.clone(), &clock, 2).unwrap_err();

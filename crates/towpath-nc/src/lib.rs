@@ -52,7 +52,7 @@ pub use safety::{
     check_cell_under_path, check_courses_within_limits, check_program, limit_violations, LimitIssue, MoveIssue, Safety,
     SafetyOptions, SafetyReport, DEFAULT_CLEARANCE, MIN_MANDREL_RADIUS, MOLD_GAP,
 };
-pub use sequencer::{seed000_sets, sequence};
+pub use sequencer::{doherty_sets, sequence};
 pub use towpath_baselines::{BaselineParams, SolverName};
 pub use verify::{measure, verify, verify_parsed, Motion, Verification, VerifyError, VerifyOptions};
 pub use width::{WidthSource, WidthUsed, PLAUSIBLE_FACTOR};

@@ -36,7 +36,7 @@ pub struct OptimizeOptions {
     /// The solver: towpath's own (default) or one of the published solvers (for comparison).
     pub solver: SolverName,
     /// Parameters of the published solvers (docs/references.md). `doherty` without `sets` gets the program's
-    /// Doherty et al.'s precedence sets ([`crate::seed000_sets`]).
+    /// Doherty et al.'s precedence sets ([`crate::doherty_sets`]).
     pub baselines: BaselineParams,
     /// The cell and clearance: with it, transits are planned against the cell (priced so by the
     /// sequencer and written so), and the output is refused unless it is free of collisions
@@ -222,7 +222,7 @@ pub fn optimize(
         width: opts.afp.width_or(dialect),
         strict_plies: opts.afp.precedence == crate::problem::PrecedenceRule::Plies,
         keep_ply_order: opts.afp.keep_ply_order,
-        seed000_sets: opts.afp.precedence == crate::problem::PrecedenceRule::Sets,
+        doherty_sets: opts.afp.precedence == crate::problem::PrecedenceRule::Sets,
     };
     let check = |text: &str| -> Result<Verification, NcError> {
         let parsed = crate::parse::parse(text, machine, dialect).map_err(|e| NcError::SelfCheck(e.to_string()))?;
@@ -401,7 +401,7 @@ pub fn apply_steps(
         width: opts.width_or(dialect),
         strict_plies: opts.precedence == crate::problem::PrecedenceRule::Plies,
         keep_ply_order: opts.keep_ply_order,
-        seed000_sets: opts.precedence == crate::problem::PrecedenceRule::Sets,
+        doherty_sets: opts.precedence == crate::problem::PrecedenceRule::Sets,
     };
     let v = verify_parsed(program, &parsed, machine, dialect, &vopts, afp.footprints.as_ref())
         .map_err(|e| NcError::SelfCheck(e.to_string()))?;

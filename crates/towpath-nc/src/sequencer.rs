@@ -2,7 +2,7 @@
 //! from `towpath-baselines`, on the same problem.
 //!
 //! Doherty et al.'s solver (`doherty`) works per precedence set: it gets the program's Doherty et al.'s precedence sets
-//! ([`seed000_sets`]) unless the caller gave its own. Every solver starts from the original
+//! ([`doherty_sets`]) unless the caller gave its own. Every solver starts from the original
 //! order (`SolveOptions::initial`) and returns it when it finds nothing cheaper.
 
 use towpath_baselines::{solve_with, BaselineError, BaselineParams, PrecedenceSet, SolverName};
@@ -24,7 +24,7 @@ use crate::program::Program;
 ///
 /// Keeping the order of the courses within each ply is not part of Doherty et al.'s model (its
 /// solver orders each set freely), so it is refused.
-pub fn seed000_sets(program: &Program, afp: &AfpProblem, opts: &AfpOptions) -> Result<Vec<PrecedenceSet>, NcError> {
+pub fn doherty_sets(program: &Program, afp: &AfpProblem, opts: &AfpOptions) -> Result<Vec<PrecedenceSet>, NcError> {
     if opts.keep_ply_order {
         return Err(NcError::DohertyKeepsNoPlyOrder);
     }
@@ -52,7 +52,7 @@ pub fn seed000_sets(program: &Program, afp: &AfpProblem, opts: &AfpOptions) -> R
 }
 
 /// Runs `solver` on the program's problem from the original order. For `doherty` without sets
-/// in `params`, the program's Doherty et al.'s precedence sets are used ([`seed000_sets`]).
+/// in `params`, the program's Doherty et al.'s precedence sets are used ([`doherty_sets`]).
 pub fn sequence(
     solver: SolverName,
     params: &BaselineParams,
@@ -74,7 +74,7 @@ pub fn sequence(
     };
     if solver == SolverName::Doherty && params.doherty.sets.is_none() {
         let mut params = params.clone();
-        params.doherty.sets = Some(seed000_sets(program, afp, afp_opts)?);
+        params.doherty.sets = Some(doherty_sets(program, afp, afp_opts)?);
         return solve_with(solver, &afp.problem, &solve_opts, &params).map_err(named);
     }
     solve_with(solver, &afp.problem, &solve_opts, params).map_err(named)

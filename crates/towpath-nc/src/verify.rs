@@ -34,7 +34,7 @@ pub struct VerifyOptions {
     pub keep_ply_order: bool,
     /// Also require Doherty et al.'s precedence sets in order: every course of a set laid before any
     /// course of the next (the verifier finds the sets on its own, from the footprints).
-    pub seed000_sets: bool,
+    pub doherty_sets: bool,
 }
 
 /// Why an optimized program does not verify.
@@ -228,7 +228,7 @@ pub fn verify_parsed(
             }
         };
         check_precedence(orig, fps, &order)?;
-        if opts.seed000_sets {
+        if opts.doherty_sets {
             check_sets(orig, fps, &order)?;
         }
         precedence_checked = true;

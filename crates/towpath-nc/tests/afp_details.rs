@@ -300,7 +300,7 @@ fn verifier_keeps_seed_000_sets_in_order_when_asked() {
     let order: Vec<Placement> = [0, 2, 1].iter().map(|&c| Placement { course: c, reversed: false }).collect();
     let out = rewrite(&p, &order, &m, &d, &[]).unwrap();
     verify(&text, &out, &m, &d, &vopts()).unwrap();
-    let sets = VerifyOptions { seed000_sets: true, ..vopts() };
+    let sets = VerifyOptions { doherty_sets: true, ..vopts() };
     let e = verify(&text, &out, &m, &d, &sets).unwrap_err();
     assert!(matches!(&e, VerifyError::Order(msg) if msg.contains("set 1") && msg.contains("set 2")), "{e}");
     // The sets' order itself passes.

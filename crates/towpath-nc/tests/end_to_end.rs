@@ -81,7 +81,7 @@ fn demo_parts_optimize_and_verify() {
 /// planned parts, and never costs more.
 #[test]
 fn doherty_sequences_the_demo_parts_set_by_set() {
-    use towpath_nc::{seed000_sets, PrecedenceRule, SolverName};
+    use towpath_nc::{doherty_sets, PrecedenceRule, SolverName};
     let d = Dialect::default();
     for part in demo_parts() {
         for precedence in [PrecedenceRule::Courses, PrecedenceRule::Sets, PrecedenceRule::Plies] {
@@ -112,7 +112,7 @@ fn doherty_sequences_the_demo_parts_set_by_set() {
                 a.off_part()
             );
             // Set by set, in order.
-            let sets = seed000_sets(&o.program, &o.afp, &afp).unwrap();
+            let sets = doherty_sets(&o.program, &o.afp, &afp).unwrap();
             let mut set_of = vec![usize::MAX; o.program.courses.len()];
             for (k, s) in sets.iter().enumerate() {
                 for t in &s.tasks {

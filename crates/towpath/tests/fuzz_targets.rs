@@ -114,7 +114,7 @@ endfacet\nendsolid s\n"
 #[test]
 fn travel_graphs() {
     let mut seeds = files(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures"), &["json"]);
-    seeds.push(towpath_coverage::write_instance(&towpath_coverage::seed004_like(5, 1).unwrap()).into_bytes());
+    seeds.push(towpath_coverage::write_instance(&towpath_coverage::tewolde_sheng_like(5, 1).unwrap()).into_bytes());
     fuzz("rpp_json", &seeds, rpp_json::run);
 }
 

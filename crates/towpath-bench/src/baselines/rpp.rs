@@ -3,7 +3,7 @@
 use std::time::Duration;
 
 use towpath_baselines::{solve_with, AcoParams, BaselineParams, GaParams, SolverName};
-use towpath_coverage::{seed004_like, RppModel, TABLE_I_SIZES};
+use towpath_coverage::{tewolde_sheng_like, RppModel, TABLE_I_SIZES};
 use towpath_seq::SolveOptions;
 
 use super::Args;
@@ -75,7 +75,7 @@ pub fn run(args: &Args) -> anyhow::Result<String> {
             aco_vs_ga: Vec::new(),
         };
         for s in 1..=seeds {
-            let model = RppModel::new(seed004_like(r, s)?)?;
+            let model = RppModel::new(tewolde_sheng_like(r, s)?)?;
             let p = model.problem();
             let mut inst: Vec<Vec<(f64, f64)>> = vec![Vec::new(); 3 + limits.len()];
             for k in 1..=runs {
@@ -145,7 +145,7 @@ fn markdown(args: &Args, results: &[SizeResult], seeds: u64, runs: u64) -> Strin
     let mut s = String::new();
     s.push_str("### Tewolde & Sheng (2008): GA vs ACO vs towpath on the open rural postman problem\n\n");
     s.push_str(&format!(
-        "Instances: `seed004_like(R, seed)` (towpath-coverage), shaped like the paper's Table I sample data \
+        "Instances: `tewolde_sheng_like(R, seed)` (towpath-coverage), shaped like the paper's Table I sample data \
          (|V| = 2|R|, patch paths as required edges, lengths in metres), {seeds} instances per size, {runs} \
          run(s) per instance and solver (solver seeds 1..{runs}). GA at Table I's settings (1000 generations, \
          population 200, crossover rate 0.2, mutation rate 0.05); ACO1/ACO2 at §VI-B's (α 1, β 5, ρ 0.5, Q 100, \

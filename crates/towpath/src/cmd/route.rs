@@ -9,7 +9,7 @@ use std::sync::Arc;
 use anyhow::{anyhow, Context};
 use towpath_baselines::{solve_with, SolverName};
 use towpath_coverage::{
-    read_instance, seed004_like, verify_route, write_instance, BuildError, Instance, RouteJson, RppModel,
+    read_instance, tewolde_sheng_like, verify_route, write_instance, BuildError, Instance, RouteJson, RppModel,
 };
 use towpath_seq::{Clock, SolveOptions};
 
@@ -162,7 +162,7 @@ fn source(args: &Args) -> String {
 
 fn load(args: &Args) -> anyhow::Result<Instance> {
     if let Some(r) = args.generate {
-        return seed004_like(r, args.generate_seed).map_err(|e| exit::bad_input(anyhow!("--generate {r}: {e}")));
+        return tewolde_sheng_like(r, args.generate_seed).map_err(|e| exit::bad_input(anyhow!("--generate {r}: {e}")));
     }
     let Some(path) = &args.graph else {
         return Err(exit::bad_input(anyhow!("give a GRAPH.json file or --generate R")));

@@ -47,7 +47,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         width,
         strict_plies: args.strict_plies || args.precedence == PrecedenceRule::Plies,
         keep_ply_order: args.keep_ply_order,
-        seed000_sets: args.precedence == PrecedenceRule::Sets,
+        doherty_sets: args.precedence == PrecedenceRule::Sets,
     };
     let m = &args.machine.machine;
     let v = verify(&original, &optimized, &machine, &dialect, &opts).map_err(|e| match e {
@@ -97,7 +97,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "verified: {} courses, same motion on-part ({} laid in reverse), precedence {}",
         v.courses,
         v.reversed,
-        match (v.precedence_checked, opts.seed000_sets, opts.strict_plies) {
+        match (v.precedence_checked, opts.doherty_sets, opts.strict_plies) {
             (false, _, true) => "kept (ply by ply)",
             (false, ..) => "not needed (one ply)",
             (true, true, _) => "kept (and Doherty et al.'s precedence sets in order)",
