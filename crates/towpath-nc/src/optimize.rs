@@ -224,12 +224,14 @@ pub fn optimize(
         keep_ply_order: opts.afp.keep_ply_order,
         doherty_sets: opts.afp.precedence == crate::problem::PrecedenceRule::Sets,
     };
-    let check = |text: &str| -> Result<Verification, NcError> {
+    // The output parsed and verified; the parse is kept for the safety checks below.
+    let check = |text: &str| -> Result<(Verification, Program), NcError> {
         let parsed = crate::parse::parse(text, machine, dialect).map_err(|e| NcError::SelfCheck(e.to_string()))?;
-        verify_parsed(&program, &parsed, machine, dialect, &vopts, afp.footprints.as_ref())
-            .map_err(|e| NcError::SelfCheck(e.to_string()))
+        let v = verify_parsed(&program, &parsed, machine, dialect, &vopts, afp.footprints.as_ref())
+            .map_err(|e| NcError::SelfCheck(e.to_string()))?;
+        Ok((v, parsed))
     };
-    let mut verification = check(&out)?;
+    let (mut verification, mut parsed) = check(&out)?;
     let identity: Vec<Placement> =
         (0..program.courses.len()).map(|c| Placement { course: c, reversed: false }).collect();
     let mut fallback = fallback_reason(&verification, opts.afp.cost);
@@ -238,24 +240,23 @@ pub fn optimize(
             // The input itself is unsafe, so it is no fallback: the solver's order is compared
             // with the input order written with safe transits, and the better one is kept.
             let safe_input = rewrite_with(&program, &identity, machine, dialect, &afp.reversed, Some(planner))?;
-            let v = check(&safe_input)?;
+            let (v, p) = check(&safe_input)?;
             fallback = worse_than(&verification, &v, opts.afp.cost);
             if fallback.is_some() {
                 order = identity;
                 out = safe_input;
-                verification = v;
+                (verification, parsed) = (v, p);
             }
         }
         _ if fallback.is_some() => {
             order = identity;
             out = text.to_string();
-            verification = check(&out)?;
+            (verification, parsed) = check(&out)?;
         }
         _ => {}
     }
     let safety = match (safety, input_safety) {
         (Some(sf), Some(before)) => {
-            let parsed = crate::parse::parse(&out, machine, dialect).map_err(|e| NcError::SelfCheck(e.to_string()))?;
             let after = check_program(&parsed, sf);
             if !after.is_safe() {
                 let mut why = vec![format!("the program towpath would write has {}", after.summary())];
@@ -269,7 +270,6 @@ pub fn optimize(
         }
         _ => {
             // Without a cell, the travel limits are still checked on what is written.
-            let parsed = crate::parse::parse(&out, machine, dialect).map_err(|e| NcError::SelfCheck(e.to_string()))?;
             let outside = limit_violations(&parsed, machine);
             if !outside.is_empty() {
                 let input = limit_violations(&program, machine).len();

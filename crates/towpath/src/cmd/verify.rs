@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use towpath_nc::{totals, verify, PrecedenceRule, VerifyError, VerifyOptions};
+use towpath_nc::{totals, verify_parsed, PrecedenceRule, VerifyError, VerifyOptions};
 
 use super::afp_common::{hint, read, warn, width_from, CellArgs, MachineArgs};
 use crate::{exit, outln};
@@ -50,18 +50,33 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         doherty_sets: args.precedence == PrecedenceRule::Sets,
     };
     let m = &args.machine.machine;
-    let v = verify(&original, &optimized, &machine, &dialect, &opts).map_err(|e| match e {
-        VerifyError::Original(e) => exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.original.display(), hint(&e, m))),
-        VerifyError::Optimized(e) => {
-            exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.optimized.display(), hint(&e, m)))
-        }
-        VerifyError::Setup(e) => exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.original.display(), hint(&e, m))),
-        e => {
-            exit::check_failed(anyhow::anyhow!("{} against {}: {e}", args.optimized.display(), args.original.display()))
-        }
-    })?;
+    // Each program is parsed once, for the verifier and the safety checks.
+    let parsed = towpath_nc::parse(&original, &machine, &dialect)
+        .map_err(VerifyError::Original)
+        .and_then(|a| Ok((a, towpath_nc::parse(&optimized, &machine, &dialect).map_err(VerifyError::Optimized)?)));
+    let v = parsed
+        .as_ref()
+        .map_err(Clone::clone)
+        .and_then(|(a, b)| verify_parsed(a, b, &machine, &dialect, &opts, None))
+        .map_err(|e| match e {
+            VerifyError::Original(e) => {
+                exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.original.display(), hint(&e, m)))
+            }
+            VerifyError::Optimized(e) => {
+                exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.optimized.display(), hint(&e, m)))
+            }
+            VerifyError::Setup(e) => {
+                exit::bad_input(anyhow::anyhow!("{}: {e}{}", args.original.display(), hint(&e, m)))
+            }
+            e => exit::check_failed(anyhow::anyhow!(
+                "{} against {}: {e}",
+                args.optimized.display(),
+                args.original.display()
+            )),
+        })?;
     let t = totals(&v);
-    let safety = check_safety(&args, &original, &optimized, &machine, &dialect, safety.as_ref())?;
+    let (a, b) = parsed.map_err(|e| anyhow::anyhow!("internal: {e}"))?;
+    let safety = check_safety(&args, &a, &b, &machine, safety.as_ref())?;
     let unsafe_after = !safety.after.is_safe();
     let from = width_from(&args.machine, &v.width, &args.machine.dialect_name());
     if let Some(w) = &v.width.warning {
@@ -133,24 +148,18 @@ struct SafetyBoth {
 
 fn check_safety(
     args: &Args,
-    original: &str,
-    optimized: &str,
+    a: &towpath_nc::Program,
+    b: &towpath_nc::Program,
     machine: &towpath_machine::Machine,
-    dialect: &towpath_nc::Dialect,
     safety: Option<&towpath_nc::Safety>,
 ) -> anyhow::Result<SafetyBoth> {
-    let parse = |text: &str, path: &std::path::Path| {
-        towpath_nc::parse(text, machine, dialect)
-            .map_err(|e| exit::bad_input(anyhow::anyhow!("{}: {e}", path.display())))
-    };
-    let (a, b) = (parse(original, &args.original)?, parse(optimized, &args.optimized)?);
     Ok(match safety {
         Some(s) => {
-            towpath_nc::check_cell_under_path(&a, machine, s, towpath_nc::MOLD_GAP)
+            towpath_nc::check_cell_under_path(a, machine, s, towpath_nc::MOLD_GAP)
                 .map_err(|e| exit::bad_input(anyhow::anyhow!("{}: {e}", args.original.display())))?;
             SafetyBoth {
-                before: towpath_nc::check_program(&a, s),
-                after: towpath_nc::check_program(&b, s),
+                before: towpath_nc::check_program(a, s),
+                after: towpath_nc::check_program(b, s),
                 checked_cell: true,
             }
         }
@@ -159,7 +168,7 @@ fn check_safety(
                 limit_violations: towpath_nc::limit_violations(p, machine),
                 ..towpath_nc::SafetyReport::default()
             };
-            SafetyBoth { before: limits(&a), after: limits(&b), checked_cell: false }
+            SafetyBoth { before: limits(a), after: limits(b), checked_cell: false }
         }
     })
 }
