@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
 import { writeFileSync, mkdirSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
-import { startServer, startBrowser, litPixels, BIN } from './harness.mjs';
+import { startServer, startBrowser, litPixels, redPixels, BIN } from './harness.mjs';
 
 let server, browser, page;
 const shots = process.env.TOWPATH_SHOTS; // folder to keep screenshots in, for a person to look at
@@ -110,6 +110,43 @@ test('a malformed program is refused with its file, line and problem', async () 
   await shot('09-malformed');
   // The view still shows the program that was open.
   assert.equal(await page.evaluate(() => window.towpath.programId), 'demo-planar-45');
+});
+
+test('a part in a cell: its collisions are marked, and a solve in the cell writes a safe program', async () => {
+  await page.locator('#program-select').selectOption('demo-planar-stringer');
+  await page.waitForFunction(() => window.towpath.timing.id === 'demo-planar-stringer', null, { timeout: 15000 });
+  // The demo part's own meshes are chosen and drawn.
+  assert.match(await page.locator('#cell-count').textContent(), /3 chosen/);
+  await page.waitForFunction(() => (window.towpath.cellDrawn || []).length === 3, null, { timeout: 10000 });
+  // Colour by feed, so that no course is red: the red in the view is the marks'.
+  await page.locator('#color-mode').selectOption('feed');
+  const redBefore = await redPixels(page, await shot('11-cell'));
+  await page.locator('#check-motion').click();
+  await page.waitForFunction(() => window.towpath.safetyChecks >= 1, null, { timeout: 30000 });
+  assert.match(await page.locator('#safety-summary').textContent(), /^program: UNSAFE · [1-9]\d* collisions?/);
+  const marked = await page.evaluate(() => window.towpath.original.markedMoves());
+  assert.ok(marked > 0, 'the colliding moves are marked');
+  const redMarked = await redPixels(page, await shot('12-cell-marked'));
+  assert.ok(redMarked > redBefore + 200, `the marks are drawn: ${redBefore} → ${redMarked} red pixels`);
+  // Hiding the marks hides them.
+  await page.locator('#show-marks').uncheck();
+  const redHidden = await redPixels(page, await shot('13-marks-hidden'));
+  assert.ok(redHidden < redMarked - 200, `hidden: ${redMarked} → ${redHidden}`);
+  await page.locator('#show-marks').check();
+  // A solve in the cell: the output is safe and says so; the input's marks stay on the input.
+  await page.locator('#opt-time').fill('1');
+  await page.locator('#solve').click();
+  await page.waitForFunction(() => window.towpath.lastResult && window.towpath.lastResult.result.original === 'demo-planar-stringer', null, { timeout: 60000 });
+  await page.waitForFunction(() => window.towpath.optimized !== null, null, { timeout: 10000 });
+  const r = await page.evaluate(() => window.towpath.lastResult.result);
+  assert.deepEqual(r.molds.length, 3);
+  assert.equal(r.safety.after.safe, true);
+  assert.equal(r.safety.after.collision_count, 0);
+  assert.match(await page.locator('#safety-summary').textContent(), /optimized: safe · 0 collisions/);
+  assert.equal(await page.evaluate(() => window.towpath.optimized.markedMoves()), 0);
+  assert.ok(await page.evaluate(() => window.towpath.original.markedMoves()) > 0);
+  await shot('14-cell-solved');
+  await page.locator('#color-mode').selectOption('ply');
 });
 
 test('the 10,000-course panel draws its first frame within 3 s of choosing it', async () => {

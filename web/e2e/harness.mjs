@@ -59,3 +59,20 @@ export async function litPixels(page, png) {
     return n;
   }, png.toString('base64'));
 }
+
+/** Counts the strongly red pixels of a PNG screenshot (the safety marks of collisions). */
+export async function redPixels(page, png) {
+  return page.evaluate(async (b64) => {
+    const img = new Image();
+    img.src = `data:image/png;base64,${b64}`;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = img.width; c.height = img.height;
+    const g = c.getContext('2d');
+    g.drawImage(img, 0, 0);
+    const d = g.getImageData(0, 0, c.width, c.height).data;
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4) if (d[i] > 200 && d[i + 1] < 110 && d[i + 2] < 110) n++;
+    return n;
+  }, png.toString('base64'));
+}

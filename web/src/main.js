@@ -2,7 +2,7 @@
 // surface view. Plain modules, no framework: the page is a tool, not a site.
 
 import { getJson, sendJson, sendBody, getBlob } from './api.js';
-import { View, ProgramLayers, KIND, softwareGL } from './viewer.js';
+import { View, ProgramLayers, KIND, softwareGL, meshObject } from './viewer.js';
 import { categorical, css, rampCss } from './colors.js';
 import { initMachine } from './machine.js';
 import { initSurface } from './surface.js';
@@ -74,7 +74,110 @@ async function loadLists(select) {
   }
   $('upload-dialect').innerHTML = dialects.map((d) => `<option>${d.name}</option>`).join('');
   if (select) sel.value = select;
+  await loadMeshes();
 }
+
+// ---------------------------------------------------------------- the cell (motion safety)
+async function loadMeshes() {
+  const chosen = chosenMolds();
+  const { meshes } = await getJson('/api/meshes');
+  app.meshes = meshes;
+  renderCell(chosen);
+}
+
+function chosenMolds() {
+  return [...document.querySelectorAll('#cell-list input:checked')].map((b) => b.dataset.mesh);
+}
+
+function renderCell(chosen) {
+  const list = $('cell-list');
+  list.innerHTML = '';
+  for (const m of app.meshes || []) {
+    const row = document.createElement('label');
+    row.className = 'check';
+    const box = document.createElement('input');
+    box.type = 'checkbox';
+    box.dataset.mesh = m;
+    box.checked = chosen.includes(m);
+    box.addEventListener('change', countCell);
+    row.append(box, document.createTextNode(` ${m}`));
+    list.appendChild(row);
+  }
+  if (!(app.meshes || []).length) list.innerHTML = '<span class="small muted">no meshes: upload one in the Surface tab</span>';
+  countCell();
+}
+
+function countCell() {
+  const n = chosenMolds().length;
+  $('cell-count').textContent = n ? `· ${n} chosen` : '· none chosen';
+  $('check-motion').disabled = n === 0;
+  drawCell();
+}
+
+// The chosen meshes drawn in the view (fetched once each).
+const cellObjects = new Map();
+async function drawCell() {
+  const chosen = new Set(chosenMolds());
+  for (const [name, obj] of cellObjects) if (obj) obj.visible = chosen.has(name) && $('show-cell').checked;
+  for (const name of chosen) {
+    if (cellObjects.has(name)) continue;
+    cellObjects.set(name, null);
+    try {
+      const obj = meshObject(await getBlob(`/api/meshes/${encodeURIComponent(name)}/geometry`));
+      cellObjects.set(name, obj);
+      view.scene.add(obj);
+      obj.visible = chosenMolds().includes(name) && $('show-cell').checked;
+    } catch (e) {
+      cellObjects.delete(name);
+      showError($('solve-error'), e);
+    }
+  }
+  app.cellDrawn = [...cellObjects.entries()].filter(([, o]) => o && o.visible).map(([n]) => n);
+  view.request();
+}
+$('show-cell').addEventListener('change', drawCell);
+
+function showSafety(lines, bad) {
+  const el = $('safety-summary');
+  el.hidden = !lines.length;
+  el.className = `safety small${bad ? ' bad' : ''}`;
+  el.textContent = lines.join('\n');
+}
+
+function safetyLine(label, r) {
+  return `${label}: ${r.safe ? 'safe' : 'UNSAFE'} · ${r.summary}`;
+}
+
+$('check-motion').onclick = async () => {
+  const molds = chosenMolds();
+  if (!app.programId || !molds.length) return;
+  const body = { molds };
+  const c = parseFloat($('opt-clearance').value);
+  if (Number.isFinite(c)) body.clearance = c;
+  $('check-motion').disabled = true;
+  showSafety(['checking…'], false);
+  try {
+    const targets = [['original', app.programId]];
+    if (app.optimized && app.lastResult && app.lastResult.result.original === app.programId) targets.push(['optimized', app.lastResult.result.program]);
+    const lines = [];
+    let bad = false;
+    for (const [which, id] of targets) {
+      const r = await sendJson(`/api/programs/${encodeURIComponent(id)}/check`, 'POST', body);
+      if (app[which]) app[which].setMarks(r.safety);
+      lines.push(safetyLine(which === 'original' ? 'program' : 'optimized', r.safety));
+      bad = bad || !r.safety.safe;
+    }
+    app.safetyChecks = (app.safetyChecks || 0) + 1;
+    showSafety(lines, bad);
+    applyVisibility();
+  } catch (e) {
+    showSafety([], false);
+    showError($('solve-error'), e);
+  } finally {
+    countCell();
+  }
+};
+$('cell').addEventListener('toggle', () => { if ($('cell').open) loadMeshes(); });
 
 function shownKinds() {
   return [true, $('show-approach').checked, $('show-transit').checked, $('show-rapid').checked];
@@ -82,6 +185,9 @@ function shownKinds() {
 
 function applyVisibility() {
   const showO = $('show-original').checked, showP = $('show-optimized').checked && app.optimized;
+  const marks = $('show-marks').checked;
+  if (app.original) app.original.setMarksShown(marks && showO);
+  if (app.optimized) app.optimized.setMarksShown(marks && !!showP);
   if (app.original) {
     const k = shownKinds();
     // Laid moves are the same in both programs: drawn once, from the optimized when it is shown.
@@ -131,7 +237,7 @@ function setPly(i, on) {
 
 $('plies-all').onclick = () => app.original && app.original.info.plies.forEach((_, i) => setPly(i, true));
 $('plies-none').onclick = () => app.original && app.original.info.plies.forEach((_, i) => setPly(i, false));
-for (const id of ['show-original', 'show-optimized', 'show-approach', 'show-transit', 'show-rapid']) $(id).addEventListener('change', applyVisibility);
+for (const id of ['show-original', 'show-optimized', 'show-approach', 'show-transit', 'show-rapid', 'show-marks']) $(id).addEventListener('change', applyVisibility);
 $('color-mode').addEventListener('change', () => {
   for (const l of [app.original, app.optimized]) if (l) l.setColorMode(colorMode());
   renderLegend();
@@ -166,6 +272,8 @@ async function openProgram(id) {
     $('program-desc').textContent = `${p ? p.description + ' · ' : ''}${info.courses.length} courses, ${info.plies.length} plies, ${info.lines.toLocaleString()} lines · machine ${p ? p.machine : ''}`;
     $('view-title').textContent = id;
     $('opt-tow').placeholder = p && p.tow_width ? `${p.tow_width} (program's)` : 'from dialect';
+    renderCell(p && p.cell ? p.cell : []);
+    showSafety([], false);
     renderPlies();
     renderLegend();
     applyVisibility();
@@ -308,6 +416,12 @@ function solveRequest() {
   if (Number.isFinite(t)) r.time_limit = t;
   const w = parseFloat($('opt-tow').value);
   if (Number.isFinite(w)) r.tow_width = w;
+  const molds = chosenMolds();
+  if (molds.length) {
+    r.molds = molds;
+    const c = parseFloat($('opt-clearance').value);
+    if (Number.isFinite(c)) r.clearance = c;
+  }
   return r;
 }
 
@@ -379,7 +493,7 @@ async function showResult(v, fresh) {
   const blob = await getBlob(`/api/programs/${encodeURIComponent(r.program)}/geometry`);
   if (app.programId !== r.original) return;
   dropLayers('optimized');
-  const layers = new ProgramLayers(blob, 'optimized');
+  const layers = new ProgramLayers(blob, 'optimized', app.original.info.plies);
   layers.setColorMode(colorMode());
   for (let i = 0; i < layers.plyCount; i++) {
     const box = document.querySelector(`#ply-list input[data-ply="${i}"]`);
@@ -387,6 +501,14 @@ async function showResult(v, fresh) {
   }
   layers.addTo(view.scene);
   app.optimized = layers;
+  if (r.safety) {
+    app.original.setMarks(r.safety.before);
+    layers.setMarks(r.safety.after);
+    showSafety([safetyLine('program', r.safety.before), safetyLine('optimized', r.safety.after)], !r.safety.after.safe);
+  } else {
+    app.original.clearMarks();
+    showSafety(r.molds && r.molds.length ? [] : ['optimized without a cell: choose its meshes and press Check motion to check it'], false);
+  }
   $('show-optimized').disabled = false;
   $('show-optimized').checked = true;
   if (fresh) $('play-which').value = 'optimized';

@@ -169,7 +169,10 @@ function rampTex() {
 
 /** A program drawn as four merged line layers. */
 export class ProgramLayers {
-  constructor(blob, role) {
+  /** `basePlies`: the plies of the program this one was optimized from. An optimized program
+   *  lays a ply in several runs, each parsed as a ply of its own; its courses are coloured and
+   *  toggled as the original's ply of the same label. */
+  constructor(blob, role, basePlies = null) {
     const { header, arrays } = blob;
     this.info = header.program;
     this.listing = header.listing;
@@ -180,10 +183,28 @@ export class ProgramLayers {
     this.segments = n;
     this.segLine = arrays.seg_line;
     this.segCourse = course;
+    this.points = P;
+    this.segFrom = from;
+    this.segTo = to;
+    this.marks = null;
+    this.marksShown = true;
+    this.scene = null;
     const courses = this.info.courses;
     const plyOf = new Int32Array(courses.length);
-    courses.forEach((c, i) => { plyOf[i] = c.ply; });
-    const nplies = Math.max(1, this.info.plies.length);
+    let nplies;
+    if (basePlies) {
+      const byLabel = new Map(basePlies.map((p, i) => [p.label, i]));
+      const own = this.info.plies.map((p) => {
+        if (!byLabel.has(p.label)) byLabel.set(p.label, byLabel.size);
+        return byLabel.get(p.label);
+      });
+      courses.forEach((c, i) => { plyOf[i] = own[c.ply]; });
+      nplies = Math.max(1, byLabel.size);
+    } else {
+      courses.forEach((c, i) => { plyOf[i] = c.ply; });
+      nplies = Math.max(1, this.info.plies.length);
+    }
+    this.plyOf = plyOf;
     this.plyCount = nplies;
     let feedMax = 1;
     for (let i = 0; i < n; i++) if (feed[i] > feedMax) feedMax = feed[i];
@@ -285,10 +306,93 @@ export class ProgramLayers {
     lay.material.uniforms.uColor.value.set(0xdfe6ee);
   }
 
-  addTo(scene) { for (const l of this.layers) scene.add(l); }
+  addTo(scene) {
+    this.scene = scene;
+    for (const l of this.layers) scene.add(l);
+    if (this.marks) scene.add(this.marks);
+  }
   removeFrom(scene) {
+    this.clearMarks();
     for (const l of this.layers) { scene.remove(l); l.geometry.dispose(); l.material.dispose(); }
     this.plyTex.dispose();
+    this.scene = null;
+  }
+
+  /** Safety marks, the fifth layer: every move of a line a safety report names, drawn over
+   *  everything (collisions red, near misses orange, travel-limit violations purple), with a
+   *  dot where each collision or near miss came closest. Returns the number of marked moves. */
+  setMarks(safety) {
+    this.clearMarks();
+    if (!safety) return 0;
+    const byLine = new Map();
+    for (const c of safety.near_misses || []) byLine.set(c.line, 1);
+    for (const c of safety.limit_violations || []) byLine.set(c.line, 2);
+    for (const c of safety.collisions || []) byLine.set(c.line, 0);
+    if (!byLine.size) return 0;
+    const palette = [[1, 0.02, 0.02], [1, 0.3, 0], [0.55, 0.12, 1]];
+    const P = this.points, marked = [];
+    for (let i = 0; i < this.segments; i++) {
+      const k = byLine.get(this.segLine[i] + 1);
+      if (k !== undefined) marked.push([i, k]);
+    }
+    // Lines are one pixel wide in WebGL, so a marked move is drawn as a thin tube (instanced
+    // cylinders) a fixed fraction of the part's size across.
+    const group = new THREE.Group();
+    const radius = Math.max(0.2, this.box.getSize(new THREE.Vector3()).length() / 500);
+    const tube = new THREE.CylinderGeometry(1, 1, 1, 8, 1, false);
+    tube.translate(0, 0.5, 0);
+    const mat = new THREE.MeshBasicMaterial({ depthTest: false, transparent: true, opacity: 0.95 });
+    const inst = new THREE.InstancedMesh(tube, mat, Math.max(1, marked.length));
+    const a = new THREE.Vector3(), b = new THREE.Vector3(), d = new THREE.Vector3(), up = new THREE.Vector3(0, 1, 0);
+    const q = new THREE.Quaternion(), m = new THREE.Matrix4(), sc = new THREE.Vector3(), col = new THREE.Color();
+    marked.forEach(([i, k], j) => {
+      a.fromArray(P, this.segFrom[i] * 3);
+      b.fromArray(P, this.segTo[i] * 3);
+      d.subVectors(b, a);
+      const len = d.length();
+      q.setFromUnitVectors(up, len > 0 ? d.clone().divideScalar(len) : up);
+      sc.set(radius, Math.max(len, 1e-6), radius);
+      m.compose(a, q, sc);
+      inst.setMatrixAt(j, m);
+      inst.setColorAt(j, col.setRGB(...palette[k]));
+    });
+    inst.count = marked.length;
+    inst.renderOrder = 20;
+    inst.frustumCulled = false;
+    group.add(inst);
+    const dots = [], dcol = [];
+    for (const [list, k] of [[safety.near_misses || [], 1], [safety.collisions || [], 0]]) {
+      for (const c of list) { dots.push(...c.at); dcol.push(...palette[k]); }
+    }
+    if (dots.length) {
+      const pg = new THREE.BufferGeometry();
+      pg.setAttribute('position', new THREE.Float32BufferAttribute(dots, 3));
+      pg.setAttribute('color', new THREE.Float32BufferAttribute(dcol, 3));
+      const pts = new THREE.Points(pg, new THREE.PointsMaterial({ size: 9, sizeAttenuation: false, vertexColors: true, depthTest: false, transparent: true }));
+      pts.renderOrder = 21;
+      pts.frustumCulled = false;
+      group.add(pts);
+    }
+    group.visible = this.marksShown;
+    group.userData = { marked: marked.length };
+    this.marks = group;
+    if (this.scene) this.scene.add(group);
+    return marked;
+  }
+
+  clearMarks() {
+    if (!this.marks) return;
+    if (this.scene) this.scene.remove(this.marks);
+    for (const o of this.marks.children) { o.geometry.dispose(); o.material.dispose(); }
+    this.marks = null;
+  }
+
+  /** Moves marked by the last safety report. */
+  markedMoves() { return this.marks ? this.marks.userData.marked : 0; }
+
+  setMarksShown(on) {
+    this.marksShown = on;
+    if (this.marks) this.marks.visible = on;
   }
 
   setColorMode(mode) { this.layers[KIND.LAYUP].material.uniforms.uMode.value = MODE[mode] ?? 1; }
@@ -313,7 +417,23 @@ export class ProgramLayers {
     const s = obj.userData.seg[local];
     if (s === undefined || s > this.upTo()) return null;
     const c = this.segCourse[s];
-    if (c >= 0 && !this.plyVisible(this.info.courses[c].ply)) return null;
+    if (c >= 0 && !this.plyVisible(this.plyOf[c])) return null;
     return s;
   }
+}
+
+/** A mesh (the `positions`/`triangles` arrays of a mesh geometry response) drawn as a
+ *  translucent grey surface: a cell's mold tool or fixture behind the paths. */
+export function meshObject(blob) {
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.BufferAttribute(blob.arrays.positions, 3));
+  g.setIndex(new THREE.BufferAttribute(blob.arrays.triangles, 1));
+  g.computeVertexNormals();
+  const mat = new THREE.MeshStandardMaterial({
+    color: 0x9aa7b4, roughness: 0.8, metalness: 0.05, transparent: true, opacity: 0.45,
+    side: THREE.DoubleSide, depthWrite: false, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
+  });
+  const obj = new THREE.Mesh(g, mat);
+  obj.renderOrder = 1;
+  return obj;
 }

@@ -135,6 +135,9 @@ pub enum NcError {
     /// The optimizer's own output did not verify (a bug: the input is left untouched).
     #[error("the optimized program did not verify: {0}")]
     SelfCheck(String),
+    /// The run was cancelled through its cancel flag.
+    #[error("cancelled")]
+    Cancelled,
 }
 
 /// A number for a message: as it is when it reads well, else in exponent form.

@@ -37,7 +37,7 @@ pub use interp::{Event, Interp, Marker, Modal};
 pub use lex::{lex, LexIssue, Lexed, NumText, Word};
 pub use optimize::{
     apply_steps, auto_time_limit, fallback_reason, optimize, Fallback, OptimizeOptions, Optimized, SafetyPair,
-    SolverSummary, Timings,
+    SolverSummary, Stage, StageFn, Timings,
 };
 pub use parse::parse;
 pub use precedence::{course_precedence, precedence_sets, MAX_VISITS};

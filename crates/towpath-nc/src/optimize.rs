@@ -1,5 +1,7 @@
 //! The whole job: parse, build the problem, sequence, rewrite, verify.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use serde::Serialize;
@@ -42,7 +44,46 @@ pub struct OptimizeOptions {
     /// sequencer and written so), and the output is refused unless it is free of collisions
     /// and limit violations.
     pub safety: Option<Safety>,
+    /// Set to stop: the solver returns at once and [`optimize`] with [`NcError::Cancelled`]
+    /// (checked between stages too).
+    pub cancel: Option<Arc<AtomicBool>>,
+    /// Called as each stage starts (for a front end's progress display).
+    pub stage: Option<StageFn>,
 }
+
+/// A stage of [`optimize`], reported to [`OptimizeOptions::stage`] as it starts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stage {
+    /// Reading the program.
+    Parsing,
+    /// Checking the input against the travel limits and the cell.
+    Checking,
+    /// Footprints, precedence, reversal and the sequencing problem.
+    Building,
+    /// The solver runs; the route cost of the input order, when it is a feasible route.
+    Solving {
+        /// Route cost of the input order (the solver's objective).
+        initial_cost: Option<f64>,
+    },
+    /// Writing the new program and verifying it against the input.
+    Writing,
+}
+
+impl Stage {
+    /// The stage in a few words.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Stage::Parsing => "parsing",
+            Stage::Checking => "checking limits and the cell",
+            Stage::Building => "building the problem",
+            Stage::Solving { .. } => "solving",
+            Stage::Writing => "writing and verifying",
+        }
+    }
+}
+
+/// A callback told of each [`Stage`].
+pub type StageFn = Arc<dyn Fn(Stage) + Send + Sync>;
 
 impl Default for OptimizeOptions {
     fn default() -> Self {
@@ -56,6 +97,8 @@ impl Default for OptimizeOptions {
             solver: SolverName::Towpath,
             baselines: BaselineParams::default(),
             safety: None,
+            cancel: None,
+            stage: None,
         }
     }
 }
@@ -129,6 +172,8 @@ pub struct Optimized {
     pub text: String,
     /// The original, parsed.
     pub program: Program,
+    /// The program returned ([`Optimized::text`]), parsed.
+    pub output: Program,
     /// The sequencing problem.
     pub afp: AfpProblem,
     /// The new order.
@@ -164,9 +209,23 @@ pub fn optimize(
     opts: &OptimizeOptions,
 ) -> Result<Optimized, NcError> {
     let t0 = Instant::now();
+    let stage = |s: Stage| {
+        if let Some(f) = &opts.stage {
+            f(s)
+        }
+    };
+    let cancelled = || -> Result<(), NcError> {
+        match &opts.cancel {
+            Some(c) if c.load(Ordering::Relaxed) => Err(NcError::Cancelled),
+            _ => Ok(()),
+        }
+    };
+    stage(Stage::Parsing);
     let program = crate::parse::parse(text, machine, dialect)?;
     let width = crate::width::WidthUsed::choose(opts.afp.width, dialect, &program);
     let t_parse = t0.elapsed().as_secs_f64();
+    cancelled()?;
+    stage(Stage::Checking);
     let t1 = Instant::now();
     let safety = opts.safety.as_ref();
     check_courses_within_limits(&program, machine)?;
@@ -177,8 +236,12 @@ pub fn optimize(
         }
         None => None,
     };
+    cancelled()?;
+    stage(Stage::Building);
     let afp = build_problem_with(&program, machine, dialect, &opts.afp, safety)?;
     let t_build = t1.elapsed().as_secs_f64();
+    cancelled()?;
+    stage(Stage::Solving { initial_cost: check(&afp.problem, &afp.original).ok() });
     let t2 = Instant::now();
     let report = sequence(
         opts.solver,
@@ -193,6 +256,7 @@ pub fn optimize(
             threads: opts.threads.max(1),
             initial: Some(afp.original.clone()),
             progress: opts.progress.clone(),
+            cancel: opts.cancel.clone(),
             ..SolveOptions::default()
         },
     )
@@ -205,6 +269,8 @@ pub fn optimize(
         _ => e,
     })?;
     let t_solve = t2.elapsed().as_secs_f64();
+    cancelled()?;
+    stage(Stage::Writing);
     let solver = SolverSummary {
         solver: opts.solver.to_string(),
         initial_cost: report.initial_cost.unwrap_or(f64::NAN),
@@ -291,6 +357,7 @@ pub fn optimize(
     Ok(Optimized {
         text: out,
         program,
+        output: parsed,
         afp,
         order,
         verification,

@@ -75,6 +75,31 @@ impl Safety {
         Ok(Safety { planner: Arc::new(planner) })
     }
 
+    /// The safety of `machine` in the cell made of `meshes` (each named, e.g. by its file, for
+    /// messages). A mesh with an index out of range or a coordinate that is not finite, and a
+    /// cell with no triangle at all, are refused.
+    pub fn from_meshes(
+        machine: &Machine,
+        dialect: &Dialect,
+        meshes: &[(String, towpath_geom::Soup)],
+        opts: SafetyOptions,
+    ) -> Result<Safety, NcError> {
+        for (name, soup) in meshes {
+            soup.validate().map_err(|e| NcError::Request(format!("{name}: {e}")))?;
+        }
+        let soups: Vec<towpath_geom::Soup> = meshes.iter().map(|(_, s)| s.clone()).collect();
+        let cell = Cell::from_soups(&soups).map_err(|e| NcError::Request(e.to_string()))?;
+        if cell.num_triangles() == 0 {
+            let names: Vec<&str> = meshes.iter().map(|(n, _)| n.as_str()).collect();
+            return Err(NcError::Request(if names.is_empty() {
+                "no mesh given: the cell is empty".to_string()
+            } else {
+                format!("{}: no triangles: the cell is empty", names.join(", "))
+            }));
+        }
+        Safety::new(machine, dialect, Arc::new(cell), opts)
+    }
+
     /// The transit planner.
     pub fn planner(&self) -> &Arc<Planner> {
         &self.planner

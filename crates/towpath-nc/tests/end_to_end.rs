@@ -169,3 +169,50 @@ fn demo_parts_save_at_least_seed_000_s_published_off_part_share() {
     }
     assert!(compared >= 6, "{compared} parts with a seed-000 figure");
 }
+
+/// Front ends follow a run by its stages and stop it with the cancel flag: the stages come in
+/// order with the input's route cost, a flag set before the run stops it with `Cancelled`, and a
+/// flag set while the solver runs (here from the first progress report) stops it too.
+#[test]
+fn optimize_reports_its_stages_and_stops_when_cancelled() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::{Arc, Mutex};
+    use towpath_nc::{NcError, Stage};
+    let d = Dialect::default();
+    let part = &demo_parts()[0];
+    let stages = Arc::new(Mutex::new(Vec::new()));
+    let seen = stages.clone();
+    let opts = OptimizeOptions {
+        afp: AfpOptions { width: Some(Width::Tow(TOW_WIDTH)), ..AfpOptions::default() },
+        time_limit: None,
+        iterations: Some(100),
+        threads: 1,
+        stage: Some(Arc::new(move |s: Stage| seen.lock().unwrap().push(s))),
+        ..OptimizeOptions::default()
+    };
+    let o = optimize(&part.program, &part.machine, &d, &opts).unwrap();
+    let stages = stages.lock().unwrap().clone();
+    let labels: Vec<&str> = stages.iter().map(Stage::label).collect();
+    assert_eq!(
+        labels,
+        ["parsing", "checking limits and the cell", "building the problem", "solving", "writing and verifying"]
+    );
+    let Stage::Solving { initial_cost: Some(initial) } = stages[3] else { panic!("{stages:?}") };
+    assert!((initial - o.solver.initial_cost).abs() <= 1e-9 * initial, "{initial} vs {}", o.solver.initial_cost);
+    // Cancelled before it starts.
+    let cancel = Arc::new(AtomicBool::new(true));
+    let opts = OptimizeOptions { cancel: Some(cancel.clone()), stage: None, ..opts };
+    assert!(matches!(optimize(&part.program, &part.machine, &d, &opts), Err(NcError::Cancelled)));
+    // Cancelled while solving, under a budget it would otherwise take a long time to spend.
+    cancel.store(false, Ordering::Relaxed);
+    let flag = cancel.clone();
+    let opts = OptimizeOptions {
+        iterations: None,
+        time_limit: Some(Duration::from_secs(600)),
+        progress: Some(Arc::new(move |_: &towpath_seq::Progress| flag.store(true, Ordering::Relaxed))),
+        ..opts
+    };
+    let t0 = std::time::Instant::now();
+    assert!(matches!(optimize(&part.program, &part.machine, &d, &opts), Err(NcError::Cancelled)));
+    assert!(t0.elapsed() < Duration::from_secs(60), "{:?}", t0.elapsed());
+}

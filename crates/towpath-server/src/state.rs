@@ -90,6 +90,10 @@ pub struct ProgramMeta {
     /// Tow width for precedence footprints when a request gives none, mm.
     #[serde(default)]
     pub tow_width: Option<f64>,
+    /// The meshes of the program's cell (mesh names): a demo part's own, or those a result was
+    /// optimized against. The solve panel starts with them chosen.
+    #[serde(default)]
+    pub cell: Vec<String>,
 }
 
 /// A program the server knows.
@@ -130,6 +134,7 @@ impl ProgramEntry {
             "original": self.meta.original,
             "job": self.meta.job,
             "tow_width": self.meta.tow_width,
+            "cell": self.meta.cell,
         })
     }
 }
@@ -165,6 +170,8 @@ pub struct Store {
     pub programs: BTreeMap<String, Arc<ProgramEntry>>,
     /// Mesh names in the workspace.
     pub meshes: Vec<String>,
+    /// Built-in meshes (the demo parts' cells) by name: their file bytes.
+    pub builtin_meshes: BTreeMap<String, Arc<Vec<u8>>>,
     /// What could not be loaded from the workspace at start, and why.
     pub load_problems: Vec<String>,
 }
@@ -202,6 +209,10 @@ impl AppState {
         );
         for d in nc::demo_parts() {
             let id = format!("demo-{}", d.name);
+            let cell: Vec<String> = d.cell.iter().map(|(name, _)| name.clone()).collect();
+            for (name, bytes) in d.cell {
+                store.builtin_meshes.insert(name, Arc::new(bytes));
+            }
             let meta = ProgramMeta {
                 machine: d.machine.name.clone(),
                 dialect: am::REFERENCE_DIALECT.into(),
@@ -210,6 +221,7 @@ impl AppState {
                 order: None,
                 job: None,
                 tow_width: Some(nc::DEMO_TOW_WIDTH),
+                cell,
             };
             store.programs.insert(id.clone(), Arc::new(ProgramEntry::new(&id, Source::Demo, meta, d.program)));
         }
@@ -227,6 +239,7 @@ impl AppState {
                 order: None,
                 job: None,
                 tow_width: Some(nc::DEMO_TOW_WIDTH),
+                cell: Vec::new(),
             },
             text: OnceLock::new(),
             make: Some(make_panel),
@@ -275,6 +288,24 @@ impl AppState {
             .get(name)
             .map(|d| d.dialect.clone())
             .ok_or_else(|| ApiError::bad(format!("no dialect {name:?}: upload it first")))
+    }
+
+    /// Every mesh name: built-in first, then the workspace's.
+    pub fn mesh_names(&self) -> Vec<String> {
+        let st = self.read();
+        st.builtin_meshes.keys().cloned().chain(st.meshes.iter().cloned()).collect()
+    }
+
+    /// A mesh's file bytes by name: a built-in one, else the workspace's.
+    pub fn mesh_bytes(&self, name: &str) -> ApiResult<Arc<Vec<u8>>> {
+        crate::names::check("mesh", name)?;
+        if let Some(b) = self.read().builtin_meshes.get(name) {
+            return Ok(b.clone());
+        }
+        self.ws
+            .read(Kind::Meshes, name)?
+            .map(Arc::new)
+            .ok_or_else(|| ApiError::bad(format!("no mesh {name:?}: upload it first")))
     }
 
     /// Registers a program written by a job (and saved in the workspace by the caller).

@@ -397,3 +397,124 @@ async fn the_front_end_is_embedded() {
     assert_eq!(s, StatusCode::OK);
     assert!(b.len() > 100_000, "three.js is bundled");
 }
+
+/// The demo stringer part's cell, checked by the library directly (the reference the API's
+/// answers are compared with).
+fn stringer_reference(program: &str) -> towpath_nc::SafetyReport {
+    let part = towpath_nc::demo::demo_parts().into_iter().find(|p| p.name == "planar-stringer").expect("demo part");
+    let dialect = towpath_nc::Dialect::default();
+    let meshes: Vec<(String, towpath_geom::Soup)> = part
+        .obstacles
+        .iter()
+        .map(|o| {
+            (
+                o.name.clone(),
+                towpath_geom::Soup::from_triangles(o.triangles.iter().map(|t| t.map(towpath_geom::DVec3::from_array))),
+            )
+        })
+        .collect();
+    let safety = towpath_nc::Safety::from_meshes(&part.machine, &dialect, &meshes, Default::default()).expect("cell");
+    let parsed = towpath_nc::parse(program, &part.machine, &dialect).expect("parses");
+    towpath_nc::check_program(&parsed, &safety)
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_cell_is_checked_and_a_solve_in_it_plans_around_it() {
+    let app = app_with("cell", |_| {});
+    // The demo part in a cell names its built-in meshes, which the mesh list has.
+    let (_, list) = get_json(&app, "/api/programs").await;
+    let part =
+        list["programs"].as_array().expect("programs").iter().find(|p| p["id"] == "demo-planar-stringer").cloned();
+    let cell: Vec<String> = part.expect("demo part")["cell"]
+        .as_array()
+        .expect("cell")
+        .iter()
+        .map(|v| v.as_str().expect("name").to_string())
+        .collect();
+    assert_eq!(cell, ["planar-stringer.tool.stl", "planar-stringer.stringer.stl", "planar-stringer.clamp.stl"]);
+    let (_, meshes) = get_json(&app, "/api/meshes").await;
+    for m in &cell {
+        assert!(meshes["meshes"].as_array().expect("meshes").iter().any(|x| x == m), "{m} not listed: {meshes}");
+    }
+    // The view draws them from their geometry (the stringer is a box: 12 triangles).
+    let (s, b) = get(&app, "/api/meshes/planar-stringer.stringer.stl/geometry").await;
+    assert_eq!(s, StatusCode::OK);
+    let (header, _) = towpath_server::geometry::decode(&b).expect("blob");
+    let tri = header["arrays"].as_array().and_then(|a| a.iter().find(|x| x["name"] == "triangles")).cloned();
+    assert_eq!(tri.and_then(|t| t["length"].as_u64()), Some(36), "{header}");
+    // Its input transits cross the stringer: the check finds what the library finds.
+    let original = demo_text(&app, "demo-planar-stringer").await;
+    let reference = stringer_reference(&original);
+    assert!(!reference.collisions.is_empty());
+    let (s, v) = post_json(&app, "/api/programs/demo-planar-stringer/check", json!({"molds": cell})).await;
+    assert_eq!(s, StatusCode::OK, "{v}");
+    let before = &v["safety"];
+    assert_eq!(before["safe"], false);
+    assert_eq!(before["collision_count"].as_u64(), Some(reference.collisions.len() as u64));
+    let lines: Vec<u64> =
+        before["collisions"].as_array().expect("list").iter().filter_map(|c| c["line"].as_u64()).collect();
+    assert_eq!(lines, reference.collisions.iter().map(|c| c.line as u64).collect::<Vec<_>>());
+    // A solve in the cell writes a program free of collisions, and says so for both programs.
+    let req = json!({"program": "demo-planar-stringer", "iterations": 300, "molds": cell, "clearance": 5.0});
+    let (s, job) = post_json(&app, "/api/jobs/optimize", req).await;
+    assert_eq!(s, StatusCode::ACCEPTED, "{job}");
+    let v = wait_final(&app, job["id"].as_str().expect("id"), Duration::from_secs(120)).await;
+    assert_eq!(v["state"], "done", "{v}");
+    let r = &v["result"];
+    assert_eq!(r["verified"], true);
+    assert_eq!(r["safety"]["before"]["collision_count"], before["collision_count"]);
+    assert_eq!(r["safety"]["after"]["safe"], true, "{}", r["safety"]);
+    let pid = r["program"].as_str().expect("program");
+    let optimized = String::from_utf8(get(&app, &format!("/api/programs/{pid}/text")).await.1).expect("utf8");
+    let after = stringer_reference(&optimized);
+    assert!(after.is_safe(), "{}", after.summary());
+    // The result keeps its cell, and checking it again finds it safe.
+    let (_, info) = get_json(&app, &format!("/api/programs/{pid}")).await;
+    assert_eq!(info["listing"]["cell"].as_array().map(Vec::len), Some(3));
+    let (s, v) = post_json(&app, &format!("/api/programs/{pid}/check"), json!({"molds": cell})).await;
+    assert_eq!(s, StatusCode::OK);
+    assert_eq!(v["safety"]["safe"], true, "{v}");
+    // Optimized without the cell, the same part's transits cross the stringer: the check says so.
+    let req = json!({"program": "demo-planar-stringer", "iterations": 300});
+    let (_, job) = post_json(&app, "/api/jobs/optimize", req).await;
+    let v = wait_final(&app, job["id"].as_str().expect("id"), Duration::from_secs(120)).await;
+    assert_eq!(v["result"]["safety"], Value::Null);
+    let blind = v["result"]["program"].as_str().expect("program").to_string();
+    let (_, v) = post_json(&app, &format!("/api/programs/{blind}/check"), json!({"molds": cell})).await;
+    assert!(v["safety"]["collision_count"].as_u64().expect("count") > 0, "{v}");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn bad_cells_are_refused() {
+    let app = app_with("badcell", |_| {});
+    let solve = |extra: Value| {
+        let mut r = json!({"program": "demo-planar-stringer", "iterations": 10});
+        for (k, v) in extra.as_object().expect("object") {
+            r[k] = v.clone();
+        }
+        r
+    };
+    let cases = [
+        (solve(json!({"clearance": 5.0})), "clearance: give the molds"),
+        (solve(json!({"molds": ["nothing.stl"]})), "no mesh \"nothing.stl\""),
+        (solve(json!({"molds": ["planar-stringer.tool.stl"], "clearance": -1})), "clearance -1"),
+        (solve(json!({"molds": ["../x.stl"]})), "mesh"),
+    ];
+    for (req, want) in cases {
+        let (s, v) = post_json(&app, "/api/jobs/optimize", req.clone()).await;
+        assert_eq!(s, StatusCode::BAD_REQUEST, "{req}: {v}");
+        assert!(v["error"].as_str().is_some_and(|e| e.contains(want)), "{req}: {v}");
+    }
+    let (s, v) = post_json(&app, "/api/programs/demo-planar-stringer/check", json!({"molds": []})).await;
+    assert_eq!(s, StatusCode::BAD_REQUEST, "{v}");
+    // A mold that is nowhere near the laid path is a wrong set-up, said before anything runs.
+    let far = "solid far\nfacet normal 0 0 1\nouter loop\nvertex 5000 5000 900\nvertex 5100 5000 900\nvertex 5000 5100 900\nendloop\nendfacet\nendsolid far\n";
+    let (s, v) = send(&app, "POST", "/api/meshes?name=far.stl", "application/octet-stream", far).await;
+    assert_eq!(s, StatusCode::CREATED, "{v}");
+    let (s, v) = post_json(&app, "/api/programs/demo-planar-stringer/check", json!({"molds": ["far.stl"]})).await;
+    assert_eq!(s, StatusCode::BAD_REQUEST, "{v}");
+    assert!(v["error"].as_str().is_some_and(|e| e.starts_with("molds: ")), "{v}");
+    // A built-in mesh's name cannot be taken by an upload.
+    let (s, v) = send(&app, "POST", "/api/meshes?name=planar-stringer.tool.stl", "application/octet-stream", far).await;
+    assert_eq!(s, StatusCode::BAD_REQUEST, "{v}");
+}

@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 use towpath_geom::surface::{Analytic, Tessellation};
-use towpath_geom::{io, BuildOptions, DVec3, Mesh, Soup};
+use towpath_geom::{BuildOptions, DVec3, Mesh};
 use towpath_layup::input::read_curve;
 use towpath_layup::output::{self, Meta, Post};
 use towpath_layup::ply::Method;
@@ -109,16 +109,9 @@ fn method(m: &str) -> Result<Method, ApiError> {
     }
 }
 
-/// Reads an uploaded mesh's bytes into triangles; errors name the file.
-fn read_soup(name: &str, bytes: &[u8]) -> Result<Soup, ApiError> {
-    let format = io::Format::from_path(std::path::Path::new(name))
-        .ok_or_else(|| ApiError::in_file(name, None, "a mesh must be a .stl, .obj or .ply file"))?;
-    io::read_bytes(bytes, format).map_err(|e| ApiError::in_file(name, None, e.to_string()))
-}
-
 /// Reads an uploaded mesh's bytes into a mesh; errors name the file.
 pub fn read_mesh(name: &str, bytes: &[u8]) -> Result<Mesh, ApiError> {
-    let soup = read_soup(name, bytes)?;
+    let soup = super::read_soup(name, bytes)?;
     let (mesh, _) =
         Mesh::build(&soup, &BuildOptions::default()).map_err(|e| ApiError::in_file(name, None, e.to_string()))?;
     Ok(mesh)
@@ -145,7 +138,7 @@ pub fn generate(
     validate(req)?;
     let units = units(req)?;
     let source = match (&req.mesh, mesh_bytes) {
-        (Some(name), Some(bytes)) => SurfaceSource::Soup(read_soup(name, bytes)?),
+        (Some(name), Some(bytes)) => SurfaceSource::Soup(super::read_soup(name, bytes)?),
         _ => SurfaceSource::Analytic(
             Analytic::parse(&req.surface).map_err(|e| ApiError::bad(format!("surface {:?}: {e}", req.surface)))?,
         ),

@@ -18,3 +18,11 @@ pub fn split_line(message: &str) -> (Option<usize>, String) {
     }
     (None, message.to_string())
 }
+
+/// Reads a mesh file's bytes (STL, OBJ or PLY, by the name's extension); errors name the file.
+pub fn read_soup(name: &str, bytes: &[u8]) -> Result<towpath_geom::Soup, crate::error::ApiError> {
+    use crate::error::ApiError;
+    let format = towpath_geom::io::Format::from_path(std::path::Path::new(name))
+        .ok_or_else(|| ApiError::in_file(name, None, "a mesh must be a .stl, .obj or .ply file"))?;
+    towpath_geom::io::read_bytes(bytes, format).map_err(|e| ApiError::in_file(name, None, e.to_string()))
+}

@@ -1,20 +1,18 @@
-//! AFP programs: demo parts, parsing, the drawable geometry of a program, optimization with
-//! progress and cancel, and reports. Every call into `towpath-nc` is here.
-//!
-//! Optimization is assembled from the library's public steps (parse, build the problem,
-//! sequence, rewrite and verify) rather than `towpath_nc::optimize`, because that function takes
-//! no cancel flag and its progress carries no starting cost; the rule that the output never costs
-//! more than the input is kept here the same way the library keeps it.
+//! AFP programs: demo parts and their cells, parsing, the drawable geometry of a program,
+//! optimization with progress and cancel (`towpath_nc::optimize`, the same run as `towpath
+//! optimize`), motion-safety checks against a cell, and reports. Every call into `towpath-nc` is
+//! here.
 
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
 use towpath_machine::{CostKind, Machine};
 use towpath_nc::{
-    apply_steps, build_problem, parse, sequence, AfpOptions, BaselineParams, NcError, Optimized, PrecedenceRule,
-    Program, Region, Report, SolverName, SolverSummary, Timings, Width,
+    parse, AfpOptions, NcError, OptimizeOptions, PrecedenceRule, Program, Region, Report, Safety, SafetyOptions,
+    SafetyReport, SolverName, Stage, Width,
 };
 
 use crate::error::ApiError;
@@ -35,14 +33,85 @@ pub struct DemoPart {
     pub machine: Machine,
     /// Program text (reference dialect).
     pub program: String,
+    /// The meshes of its cell (mold tool, stringers, fixtures) as (file name, STL bytes); the
+    /// names are those `towpath demo` writes (`part.obstacle.stl`).
+    pub cell: Vec<(String, Vec<u8>)>,
 }
 
-/// The built-in demo parts (Doherty et al. (2022)'s test parts).
+/// The built-in demo parts (Doherty et al. (2022)'s test parts, and the parts in a cell).
 pub fn demo_parts() -> Vec<DemoPart> {
     towpath_nc::demo::demo_parts()
         .into_iter()
-        .map(|p| DemoPart { name: p.name, description: p.description, machine: p.machine, program: p.program })
+        .map(|p| {
+            let cell = p
+                .obstacles
+                .iter()
+                .map(|o| {
+                    let soup = towpath_geom::Soup::from_triangles(
+                        o.triangles.iter().map(|t| t.map(towpath_geom::DVec3::from_array)),
+                    );
+                    let mut stl = Vec::new();
+                    // Writing into memory cannot fail.
+                    let _ = towpath_geom::io::write_stl(&mut stl, &soup);
+                    (format!("{}.{}.stl", p.name, o.name), stl)
+                })
+                .collect();
+            DemoPart { name: p.name, description: p.description, machine: p.machine, program: p.program, cell }
+        })
         .collect()
+}
+
+/// The motion-safety set-up of a machine in the cell made of `meshes` (name, file bytes: STL,
+/// OBJ or PLY), keeping `clearance` mm (default [`towpath_nc::DEFAULT_CLEARANCE`]).
+pub fn cell(
+    machine: &Machine,
+    dialect: &Dialect,
+    meshes: &[(String, Arc<Vec<u8>>)],
+    clearance: Option<f64>,
+) -> Result<Safety, ApiError> {
+    let mut soups = Vec::with_capacity(meshes.len());
+    for (name, bytes) in meshes {
+        soups.push((name.clone(), super::read_soup(name, bytes)?));
+    }
+    let opts = SafetyOptions { clearance: clearance.unwrap_or(towpath_nc::DEFAULT_CLEARANCE), ..Default::default() };
+    Safety::from_meshes(machine, dialect, &soups, opts).map_err(|e| ApiError::bad(format!("molds: {e}")))
+}
+
+/// Most issues of each kind a safety report lists in a response (the counts are always whole).
+pub const MAX_LISTED_ISSUES: usize = 2000;
+
+/// A safety report as the front end reads it: counts, the least clearance and the issues
+/// (each list cut at [`MAX_LISTED_ISSUES`]).
+pub fn safety_json(r: &SafetyReport) -> Value {
+    let cut = |v: &[towpath_nc::MoveIssue]| v.iter().take(MAX_LISTED_ISSUES).cloned().collect::<Vec<_>>();
+    json!({
+        "safe": r.is_safe(),
+        "summary": r.summary(),
+        "clearance": r.clearance,
+        "moves_checked": r.moves_checked,
+        "min_clearance": r.min_clearance.map(|(d, line)| json!({"mm": d, "line": line})),
+        "collision_count": r.collisions.len(),
+        "near_miss_count": r.near_misses.len(),
+        "limit_violation_count": r.limit_violations.len(),
+        "collisions": cut(&r.collisions),
+        "near_misses": cut(&r.near_misses),
+        "limit_violations": r.limit_violations.iter().take(MAX_LISTED_ISSUES).collect::<Vec<_>>(),
+    })
+}
+
+/// Checks a program's motion against a cell and the machine's travel limits (the checks of
+/// `towpath verify --mold`). The cell must lie under the laid path, as `towpath` requires.
+pub fn check_safety(
+    file: &str,
+    text: &str,
+    machine: &Machine,
+    dialect: &Dialect,
+    safety: &Safety,
+) -> Result<SafetyReport, ApiError> {
+    let program = parse(text, machine, dialect).map_err(|e| program_error(file, e))?;
+    towpath_nc::check_cell_under_path(&program, machine, safety, towpath_nc::MOLD_GAP)
+        .map_err(|e| ApiError::bad(format!("molds: {e}")))?;
+    Ok(towpath_nc::check_program(&program, safety))
 }
 
 /// The large stacked panel (`plies` × about `courses` courses) on the gantry machine.
@@ -258,6 +327,11 @@ pub struct OptimizeRequest {
     pub seed: u64,
     /// Solver threads (default 1, so that queued jobs share the machine fairly).
     pub threads: Option<usize>,
+    /// Meshes of the cell (names of built-in or uploaded meshes): with them, transits are
+    /// planned around the cell and every move is checked, as `towpath optimize --mold`.
+    pub molds: Vec<String>,
+    /// Clearance kept from the cell, mm (default 5; needs `molds`).
+    pub clearance: Option<f64>,
 }
 
 impl Default for OptimizeRequest {
@@ -274,6 +348,8 @@ impl Default for OptimizeRequest {
             iterations: None,
             seed: 1,
             threads: None,
+            molds: Vec::new(),
+            clearance: None,
         }
     }
 }
@@ -314,6 +390,14 @@ impl OptimizeRequest {
         if self.threads == Some(0) {
             return Err(ApiError::bad("threads: at least 1"));
         }
+        if let Some(c) = self.clearance {
+            if self.molds.is_empty() {
+                return Err(ApiError::bad("clearance: give the molds of the cell to keep it from"));
+            }
+            if !(c.is_finite() && c > 0.0 && c <= 1e4) {
+                return Err(ApiError::bad(format!("clearance {c}: a distance in mm > 0 and at most 10000")));
+            }
+        }
         Ok(Checked {
             afp: AfpOptions {
                 cost,
@@ -350,7 +434,7 @@ pub struct Hooks {
     /// Set to stop.
     pub cancel: Arc<AtomicBool>,
     /// Called with the phase name when it changes.
-    pub phase: Box<dyn Fn(&str) + Send + Sync>,
+    pub phase: Arc<dyn Fn(&str) + Send + Sync>,
     /// Called as the solver progresses.
     pub progress: Arc<dyn Fn(&SolveProgress) + Send + Sync>,
 }
@@ -417,6 +501,8 @@ pub struct OptimizeOutcome {
     pub solver_cost: (f64, f64),
     /// Courses laid reversed.
     pub reversed: usize,
+    /// The motion safety of the input and of the output, when the request gave a cell.
+    pub safety: Option<towpath_nc::SafetyPair>,
 }
 
 /// Why an optimization stopped without a result.
@@ -433,121 +519,84 @@ impl From<ApiError> for Stopped {
     }
 }
 
-/// Optimizes a program (see the module docs for how).
+/// Optimizes a program with `towpath_nc::optimize` (the run `towpath optimize` makes: the
+/// output never costs more than the input and never takes longer, and with a cell every transit
+/// is planned around it and the output is refused unless it is safe).
 pub fn optimize(
     file: &str,
     text: &str,
     machine: &Machine,
     dialect: &Dialect,
     req: &OptimizeRequest,
+    safety: Option<Safety>,
     hooks: &Hooks,
 ) -> Result<OptimizeOutcome, Stopped> {
     let mut checked = req.check()?;
     if req.cost == "auto" {
         checked.afp.cost = towpath_nc::default_cost(machine);
     }
-    let cancelled = || hooks.cancel.load(Ordering::Relaxed);
-    let t0 = Instant::now();
-    (hooks.phase)("parsing");
-    let program = parse(text, machine, dialect).map_err(|e| program_error(file, e))?;
-    let t_parse = t0.elapsed().as_secs_f64();
-    if cancelled() {
-        return Err(Stopped::Cancelled);
-    }
-    (hooks.phase)("building the problem");
-    let t1 = Instant::now();
-    let afp = build_problem(&program, machine, dialect, &checked.afp).map_err(|e| program_error(file, e))?;
-    let t_build = t1.elapsed().as_secs_f64();
-    if cancelled() {
-        return Err(Stopped::Cancelled);
-    }
-    let initial_cost = towpath_seq::check(&afp.problem, &afp.original).ok();
-    (hooks.progress)(&SolveProgress { initial_cost, best_cost: initial_cost, iterations: 0, fraction: 0.0 });
-    (hooks.phase)("solving");
     let time_limit = match (req.time_limit, req.iterations) {
         (Some(t), _) => Some(Duration::from_secs_f64(t)),
         (None, Some(_)) => None,
-        (None, None) => Some(towpath_nc::auto_time_limit(program.courses.len())),
+        // As `towpath optimize`: the course count by the dialect's contact code.
+        (None, None) => Some(towpath_nc::auto_time_limit(if dialect.contact_on.is_empty() {
+            1000
+        } else {
+            text.lines().filter(|l| l.contains(dialect.contact_on.as_str())).count().max(1)
+        })),
     };
-    let cb = hooks.progress.clone();
-    let progress: towpath_seq::ProgressFn = Arc::new(move |p: &towpath_seq::Progress| {
-        cb(&SolveProgress {
-            initial_cost,
-            best_cost: Some(p.best_cost),
-            iterations: p.iterations,
-            fraction: p.fraction,
+    // The input's route cost arrives with the solving stage; progress reports it beside the best.
+    let initial: Arc<Mutex<Option<f64>>> = Arc::new(Mutex::new(None));
+    let stage: towpath_nc::StageFn = {
+        let (initial, progress, phase) = (initial.clone(), hooks.progress.clone(), hooks.phase.clone());
+        Arc::new(move |s: Stage| {
+            phase(s.label());
+            if let Stage::Solving { initial_cost } = s {
+                *initial.lock().unwrap_or_else(|e| e.into_inner()) = initial_cost;
+                progress(&SolveProgress { initial_cost, best_cost: initial_cost, iterations: 0, fraction: 0.0 });
+            }
         })
-    });
-    let t2 = Instant::now();
-    let solve_opts = towpath_seq::SolveOptions {
+    };
+    let progress: towpath_seq::ProgressFn = {
+        let (initial, cb) = (initial.clone(), hooks.progress.clone());
+        Arc::new(move |p: &towpath_seq::Progress| {
+            cb(&SolveProgress {
+                initial_cost: *initial.lock().unwrap_or_else(|e| e.into_inner()),
+                best_cost: Some(p.best_cost),
+                iterations: p.iterations,
+                fraction: p.fraction,
+            })
+        })
+    };
+    let opts = OptimizeOptions {
+        afp: checked.afp.clone(),
         time_limit,
         iterations: req.iterations,
         seed: req.seed,
         threads: req.threads.unwrap_or(1),
-        initial: Some(afp.original.clone()),
         progress: Some(progress),
+        solver: checked.solver,
+        baselines: towpath_nc::BaselineParams::default(),
+        safety,
         cancel: Some(hooks.cancel.clone()),
-        ..towpath_seq::SolveOptions::default()
+        stage: Some(stage),
     };
-    let report = sequence(checked.solver, &BaselineParams::default(), &program, &afp, &checked.afp, &solve_opts)
-        .map_err(|e| program_error(file, e))?;
-    let t_solve = t2.elapsed().as_secs_f64();
-    if cancelled() {
+    let o = towpath_nc::optimize(text, machine, dialect, &opts).map_err(|e| match e {
+        NcError::Cancelled => Stopped::Cancelled,
+        e => Stopped::Failed(program_error(file, e)),
+    })?;
+    if hooks.cancel.load(Ordering::Relaxed) {
         return Err(Stopped::Cancelled);
     }
     (hooks.progress)(&SolveProgress {
-        initial_cost,
-        best_cost: Some(report.solution.cost),
-        iterations: report.iterations,
+        initial_cost: *initial.lock().unwrap_or_else(|e| e.into_inner()),
+        best_cost: Some(o.solver.cost),
+        iterations: o.solver.iterations,
         fraction: 1.0,
     });
-    (hooks.phase)("writing and verifying");
-    let t3 = Instant::now();
-    let (mut out, mut verification) =
-        apply_steps(&program, &afp, &report.solution.steps, machine, dialect, &checked.afp)
-            .map_err(|e| program_error(file, e))?;
-    let mut order: Vec<towpath_nc::Placement> = towpath_nc::placements(&report.solution.steps);
-    // The library's guard: never a longer cycle time nor more off-part cost than the input.
-    let fallback = towpath_nc::fallback_reason(&verification, checked.afp.cost);
-    if fallback.is_some() {
-        let again = apply_steps(&program, &afp, &afp.original, machine, dialect, &checked.afp)
-            .map_err(|e| program_error(file, e))?;
-        out = again.0;
-        verification = again.1;
-        order = towpath_nc::placements(&afp.original);
-    }
-    let t_verify = t3.elapsed().as_secs_f64();
-    let optimized_program = parse(&out, machine, dialect).map_err(|e| program_error(file, e))?;
-    let width = towpath_nc::WidthUsed::choose(checked.afp.width, dialect, &program);
-    let o = Optimized {
-        text: out,
-        program,
-        afp,
-        order,
-        verification,
-        solver: SolverSummary {
-            solver: checked.solver.to_string(),
-            initial_cost: report.initial_cost.unwrap_or(f64::NAN),
-            cost: report.solution.cost,
-            iterations: report.iterations,
-            exact: report.exact,
-        },
-        timings: Timings {
-            parse: t_parse,
-            build: t_build,
-            solve: t_solve,
-            rewrite: 0.0,
-            verify: t_verify,
-            total: t0.elapsed().as_secs_f64(),
-        },
-        fell_back: fallback.is_some(),
-        fallback,
-        width,
-        safety: None,
-    };
     let report = Report::new(file, machine, &o, &checked.afp);
     let report_json = serde_json::to_string_pretty(&report).map_err(|e| ApiError::Internal(e.to_string()))?;
-    let report_html = report.to_html(&o, &optimized_program, machine);
+    let report_html = report.to_html(&o, &o.output, machine);
     let savings = report
         .totals
         .iter()
@@ -598,6 +647,7 @@ pub fn optimize(
         verdict,
         fell_back: o.fell_back,
         solver_cost: (o.solver.initial_cost, o.solver.cost),
+        safety: o.safety,
     })
 }
 

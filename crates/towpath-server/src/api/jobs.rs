@@ -18,7 +18,6 @@ use crate::error::{ApiError, ApiResult};
 use crate::jobs::{JobOutput, JobView, Jobs};
 use crate::names;
 use crate::state::{AppState, ProgramMeta};
-use crate::workspace::Kind;
 
 /// How often progress is sent while a job runs.
 pub const TICK: Duration = Duration::from_millis(100);
@@ -103,6 +102,8 @@ pub async fn optimize(
     if req.tow_width.is_none() && req.course_width.is_none() {
         req.tow_width = entry.meta.tow_width;
     }
+    // The cell's meshes are looked up now, so that a wrong name is refused before the job.
+    let meshes = req.molds.iter().map(|m| Ok((m.clone(), s.mesh_bytes(m)?))).collect::<ApiResult<Vec<_>>>()?;
     let program_id = entry.id.clone();
     let meta = entry.meta.clone();
     let work = Box::new(move |ctx: &crate::jobs::JobCtx| {
@@ -111,10 +112,16 @@ pub async fn optimize(
         let c2 = ctx.clone();
         let hooks = nc::Hooks {
             cancel: ctx.cancel_flag(),
-            phase: Box::new(move |p| c1.phase(p)),
+            phase: Arc::new(move |p| c1.phase(p)),
             progress: Arc::new(move |p| c2.progress(p)),
         };
-        let out = nc::optimize(&program_id, &text, &machine, &dialect, &req, &hooks)?;
+        let safety = if meshes.is_empty() {
+            None
+        } else {
+            ctx.phase("reading the cell");
+            Some(nc::cell(&machine, &dialect, &meshes, req.clearance)?)
+        };
+        let out = nc::optimize(&program_id, &text, &machine, &dialect, &req, safety, &hooks)?;
         let stem = program_id.strip_suffix(".nc").unwrap_or(&program_id);
         let job_id = ctx.id();
         let new_id = format!("{stem}-opt-{job_id}");
@@ -130,6 +137,11 @@ pub async fn optimize(
             "reversed": out.reversed,
             "cost": out.cost,
             "download_name": format!("{stem}-optimized.nc"),
+            "molds": req.molds,
+            "safety": out.safety.as_ref().map(|p| json!({
+                "before": nc::safety_json(&p.before),
+                "after": nc::safety_json(&p.after),
+            })),
         });
         let pmeta = ProgramMeta {
             machine: meta.machine.clone(),
@@ -139,6 +151,7 @@ pub async fn optimize(
             order: Some(out.order.clone()),
             job: Some(job_id),
             tow_width: meta.tow_width,
+            cell: if req.molds.is_empty() { meta.cell.clone() } else { req.molds.clone() },
         };
         Ok(JobOutput {
             result,
@@ -167,10 +180,7 @@ pub async fn layup(
     let mesh_bytes = match &req.mesh {
         Some(name) => {
             names::check("mesh", name)?;
-            Some(
-                s.ws.read(Kind::Meshes, name)?
-                    .ok_or_else(|| ApiError::bad(format!("no mesh {name:?}: upload it first")))?,
-            )
+            Some(s.mesh_bytes(name)?)
         }
         None => None,
     };
@@ -178,7 +188,7 @@ pub async fn layup(
     let work = Box::new(move |ctx: &crate::jobs::JobCtx| {
         ctx.phase("building the surface and tracing courses");
         let c = ctx.clone();
-        let out = layup::generate(&req, mesh_bytes.as_deref(), &mut |n| c.count(n as u64))?;
+        let out = layup::generate(&req, mesh_bytes.as_ref().map(|b| b.as_slice()), &mut |n| c.count(n as u64))?;
         Ok(JobOutput {
             result: json!({ "summary": out.summary }),
             files: vec![

@@ -126,6 +126,7 @@ pub async fn upload(
             ),
             None => None,
         },
+        cell: Vec::new(),
     };
     let meta_bytes = serde_json::to_vec_pretty(&meta).map_err(|e| ApiError::Internal(e.to_string()))?;
     s.ws.write(Kind::Programs, &name, text.as_bytes())?;
@@ -133,4 +134,41 @@ pub async fn upload(
     s.add_program(&name, Source::Upload, meta, text);
     let listing = s.program(&name)?.listing();
     Ok((StatusCode::CREATED, Json(json!({ "listing": listing, "summary": summary }))))
+}
+
+/// What `POST /api/programs/{id}/check` takes: the cell's meshes and the clearance.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckRequest {
+    /// Mesh names (built-in or uploaded).
+    molds: Vec<String>,
+    /// Clearance, mm (default 5).
+    #[serde(default)]
+    clearance: Option<f64>,
+}
+
+/// `POST /api/programs/{id}/check`: the program's motion checked against the cell made of the
+/// named meshes and the machine's travel limits (as `towpath verify --mold`): counts, the least
+/// clearance and each collision, near miss and limit violation by line.
+pub async fn check(
+    State(s): State<Arc<AppState>>,
+    Path(id): Path<String>,
+    body: Result<Json<CheckRequest>, axum::extract::rejection::JsonRejection>,
+) -> ApiResult<Json<Value>> {
+    let Json(req) = body.map_err(|e| ApiError::bad(format!("request: {}", e.body_text())))?;
+    if req.molds.is_empty() {
+        return Err(ApiError::bad("molds: give at least one mesh of the cell"));
+    }
+    let p = s.program(&id)?;
+    let machine = s.machine(&p.meta.machine)?;
+    let dialect = s.dialect(&p.meta.dialect)?;
+    let meshes = req.molds.iter().map(|m| Ok((m.clone(), s.mesh_bytes(m)?))).collect::<ApiResult<Vec<_>>>()?;
+    let report = tokio::task::spawn_blocking(move || -> ApiResult<Value> {
+        let safety = nc::cell(&machine, &dialect, &meshes, req.clearance)?;
+        let r = nc::check_safety(&p.id, &p.text(), &machine, &dialect, &safety)?;
+        Ok(nc::safety_json(&r))
+    })
+    .await
+    .map_err(|e| ApiError::Internal(e.to_string()))??;
+    Ok(Json(json!({ "program": id, "safety": report })))
 }

@@ -7,7 +7,8 @@ use std::sync::Arc;
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::{Path, Query, State};
-use axum::http::{HeaderMap, StatusCode};
+use axum::http::{header, HeaderMap, StatusCode};
+use axum::response::{IntoResponse, Response};
 use axum::Json;
 use serde::Deserialize;
 use serde_json::{json, Value};
@@ -147,7 +148,8 @@ pub async fn save_dialect(
 }
 
 pub async fn meshes(State(s): State<Arc<AppState>>) -> Json<Value> {
-    Json(json!({ "meshes": s.read().meshes }))
+    let builtin: Vec<String> = s.read().builtin_meshes.keys().cloned().collect();
+    Json(json!({ "meshes": s.mesh_names(), "builtin": builtin }))
 }
 
 /// `POST /api/meshes?name=N.stl`: read as a mesh before it is kept.
@@ -159,6 +161,9 @@ pub async fn upload_mesh(
     let bytes = super::upload(&s, body)?;
     let name = q.get("name").cloned().ok_or_else(|| ApiError::bad("name: give the mesh's file name"))?;
     names::check("mesh", &name)?;
+    if s.read().builtin_meshes.contains_key(&name) {
+        return Err(ApiError::bad(format!("{name}: a built-in mesh has this name; choose another")));
+    }
     let n = name.clone();
     let b = bytes.clone();
     let faces = tokio::task::spawn_blocking(move || layup::read_mesh(&n, &b).map(|m| m.num_faces()))
@@ -171,4 +176,15 @@ pub async fn upload_mesh(
         st.meshes.sort();
     }
     Ok((StatusCode::CREATED, Json(json!({"name": name, "triangles": faces}))))
+}
+
+/// `GET /api/meshes/{name}/geometry`: a mesh's vertices and triangles as typed arrays (the
+/// program view draws a cell's meshes with it).
+pub async fn mesh_geometry(State(s): State<Arc<AppState>>, Path(name): Path<String>) -> ApiResult<Response> {
+    let bytes = s.mesh_bytes(&name)?;
+    let blob =
+        tokio::task::spawn_blocking(move || layup::read_mesh(&name, &bytes).map(|m| layup::mesh_blob(&m).encode()))
+            .await
+            .map_err(|e| ApiError::Internal(e.to_string()))??;
+    Ok(([(header::CONTENT_TYPE, "application/octet-stream")], blob).into_response())
 }

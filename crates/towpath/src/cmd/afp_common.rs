@@ -179,27 +179,17 @@ impl CellArgs {
         if self.molds.is_empty() {
             return Ok(None);
         }
-        let mut soups = Vec::with_capacity(self.molds.len());
+        let mut meshes = Vec::with_capacity(self.molds.len());
         for path in &self.molds {
             let soup = towpath_geom::io::read_path(path)
                 .map_err(|e| exit::bad_input(anyhow::anyhow!("{}: {e}", path.display())))?;
-            if let Err(e) = soup.validate() {
-                return Err(exit::bad_input(anyhow::anyhow!("{}: {e}", path.display())));
-            }
-            soups.push(soup);
-        }
-        let cell = towpath_motion::Cell::from_soups(&soups).map_err(|e| exit::bad_input(anyhow::anyhow!("{e}")))?;
-        if cell.num_triangles() == 0 {
-            return Err(exit::bad_input(anyhow::anyhow!(
-                "{}: no triangles: the cell is empty",
-                self.molds.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
-            )));
+            meshes.push((path.display().to_string(), soup));
         }
         let opts = towpath_nc::SafetyOptions {
             clearance: self.clearance.unwrap_or(towpath_nc::DEFAULT_CLEARANCE),
             ..towpath_nc::SafetyOptions::default()
         };
-        towpath_nc::Safety::new(machine, dialect, std::sync::Arc::new(cell), opts)
+        towpath_nc::Safety::from_meshes(machine, dialect, &meshes, opts)
             .map(Some)
             .map_err(|e| exit::bad_input(anyhow::anyhow!("--mold: {e}")))
     }

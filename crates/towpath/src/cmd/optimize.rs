@@ -123,6 +123,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         solver: args.solver.solver,
         baselines: args.solver.params(),
         safety,
+        cancel: None,
+        stage: None,
     };
     let o = optimize(&text, &machine, &dialect, &opts).map_err(|e| classify(&args.program, &args.machine.machine, e));
     if let Some(b) = &bar {
@@ -140,9 +142,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(path) = &args.report {
         let body = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("html") || e.eq_ignore_ascii_case("htm"))
         {
-            let optimized = towpath_nc::parse(&o.text, &machine, &dialect)
-                .map_err(|e| classify(&args.output, &args.machine.machine, e))?;
-            report.to_html(&o, &optimized, &machine)
+            report.to_html(&o, &o.output, &machine)
         } else {
             serde_json::to_string_pretty(&report)?
         };
