@@ -170,3 +170,20 @@ test('the 10,000-course panel draws its first frame within 3 s of choosing it', 
   const lit = await litPixels(page, await shot('10-panel'));
   assert.ok(lit > 5000, `panel view blank (${lit})`);
 });
+
+test('the surface view takes its lengths in inches and says so', async () => {
+  await page.locator('.tab[data-tab="surface"]').click();
+  await page.locator('#s-desc').fill('cylinder:r=12,l=40');
+  await page.locator('#s-units').selectOption('in');
+  assert.equal(await page.locator('#s-tow-unit').textContent(), 'in');
+  await page.locator('#s-tow').fill('0.25');
+  await page.locator('#s-run').click();
+  await page.waitForSelector('#s-summary:not([hidden])', { timeout: 60000 });
+  const text = await page.locator('#s-summary').textContent();
+  assert.match(text, /inputs in inches; lengths here in mm/);
+  // 12 in × 40 in cylinder: 2π · 304.8 mm · 1016 mm = 1.946 m².
+  const m2 = Number(text.match(/of ([\d.]+) m²/)[1]);
+  assert.ok(Math.abs(m2 - (2 * Math.PI * 304.8 * 1016) / 1e6) < 0.01, `${m2} m²`);
+  if (shots) await page.screenshot({ path: join(shots, '15-surface-inches.png') });
+  await page.locator('.tab[data-tab="program"]').click();
+});

@@ -33,6 +33,7 @@ function request() {
     guides: $('s-guides').value.split(/\n\s*\n/).map((s) => s.trim()).filter(Boolean),
   };
   if (kind === 'mesh') r.mesh = $('s-mesh').value; else r.surface = $('s-desc').value.trim();
+  if ($('s-units').value !== 'mm') r.units = $('s-units').value;
   return r;
 }
 
@@ -127,6 +128,7 @@ async function showResult(v) {
   s.innerHTML = `<span class="lbl">Ply</span>
     <table class="tbl">
     <tr><td>courses</td><td>${doc.summary.courses}</td></tr>
+    <tr><td>units</td><td>inputs in ${{ mm: 'mm', in: 'inches', m: 'metres', ft: 'feet' }[doc.meta.input_units] || doc.meta.input_units || 'mm'}; lengths here in mm</td></tr>
     <tr><td>coverage</td><td>${q.coverage_percent.toFixed(2)} % of ${(q.ply_area / 1e6).toFixed(3)} m²</td></tr>
     <tr><td>gaps / overlaps</td><td>${q.gap_area.toFixed(0)} / ${q.overlap_area.toFixed(0)} mm²</td></tr>
     <tr><td>min steering radius</td><td>${q.min_steering_radius ? q.min_steering_radius.toFixed(0) + ' mm' : 'straight'}</td></tr>
@@ -157,6 +159,7 @@ export async function initSurface() {
     e.target.value = '';
   };
   $('s-color').onchange = drawTows;
+  $('s-units').onchange = (e) => { $('s-tow-unit').textContent = e.target.value; };
   $('s-run').onclick = async () => {
     message($('s-error'), '');
     try {
