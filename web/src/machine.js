@@ -53,6 +53,9 @@ function render() {
     tr.querySelector('button').onclick = () => { machine.dh.splice(i, 1); render(); };
     d.appendChild(tr);
   });
+  $('m-head-on').checked = !!machine.head;
+  $('m-head').hidden = !machine.head;
+  for (const k of ['radius', 'bottom', 'top']) $(`m-head-${k}`).value = machine.head ? machine.head[k] ?? '' : '';
   const vs = $('m-values');
   vs.innerHTML = '';
   machine.axis.forEach((a, i) => {
@@ -105,6 +108,19 @@ export async function initMachine() {
   $('m-select').onchange = (e) => load(e.target.value);
   $('m-add-axis').onclick = () => { machine.axis.push({ label: 'U', kind: 'linear', weight: 1 }); render(); };
   $('m-add-dh').onclick = () => { machine.dh.push({ a: 0, d: 0, alpha: 0, theta: 0 }); render(); };
+  // The head: a capsule along the tool axis (towpath_machine::Head); a typical AFP head to start.
+  $('m-head-on').onchange = (e) => {
+    if (e.target.checked) machine.head = { radius: 40, bottom: 45, top: 300 };
+    else delete machine.head;
+    render();
+  };
+  $('m-head').addEventListener('input', (e) => {
+    const k = e.target.dataset.k;
+    if (!k || !machine.head) return;
+    const v = num(e.target.value);
+    if (v === undefined) delete machine.head[k]; else machine.head[k] = v;
+    schedule();
+  });
   $('m-save').onclick = async () => {
     const name = $('m-name').value.trim();
     try {

@@ -366,6 +366,7 @@ async fn machines_are_checked_saved_and_previewed() {
     assert_eq!(s, StatusCode::OK);
     let mut m = v["machine"].clone();
     m["name"] = json!("my-gantry");
+    m["head"] = json!({"radius": 40.0, "bottom": 45.0, "top": 300.0});
     // Preview: a Cartesian gantry's tool point is its X, Y, Z.
     let (s, p) =
         post_json(&app, "/api/machine-preview", json!({"machine": m, "values": [10.0, 20.0, 30.0, 90.0]})).await;
@@ -376,7 +377,13 @@ async fn machines_are_checked_saved_and_previewed() {
     assert_eq!(s, StatusCode::OK);
     assert!(app.dir.join("ws/machines/my-gantry.toml").exists());
     let again = AppState::new(app.state.config.clone()).expect("state");
-    assert!(again.machine("my-gantry").is_ok());
+    assert_eq!(again.machine("my-gantry").expect("saved").head.map(|h| h.top), Some(300.0));
+    // A head reaching below the tool point is refused, named by its key.
+    let mut low = m.clone();
+    low["head"]["bottom"] = json!(10.0);
+    let (s, v) = post_json(&app, "/api/machine-preview", json!({"machine": low})).await;
+    assert_eq!(s, StatusCode::BAD_REQUEST, "{v}");
+    assert!(v["error"].as_str().is_some_and(|e| e.contains("head.bottom")), "{v}");
     // A machine with no axes is refused; built-ins cannot be overwritten.
     let mut bad = m.clone();
     bad["axis"] = json!([]);
