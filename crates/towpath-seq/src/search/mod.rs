@@ -151,107 +151,157 @@ pub enum SolveError {
 /// The most worker threads [`solve`] runs (each keeps its own copy of the tour).
 pub const MAX_THREADS: usize = 1024;
 
-/// Solves a problem with towpath's best solver.
+/// Solves a problem with towpath's best solver: exactly when it is small, else nearest-neighbour
+/// starts, candidate lists, a first descent and the iterated local search in epochs (shared
+/// between threads at each epoch's end), then a last full descent.
 pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<SolveReport, SolveError> {
     if opts.threads > MAX_THREADS {
         return Err(SolveError::TooManyThreads { threads: opts.threads });
     }
     let clock = Clock::for_options(opts);
     let t0 = clock.started();
-    let deadline = clock.deadline();
     let initial_cost = match &opts.initial {
         Some(steps) => Some(check(problem, steps).map_err(SolveError::BadInitial)?),
         None => None,
     };
-    let n = problem.num_tasks();
-    if n <= opts.exact_up_to.min(crate::MAX_EXACT_TASKS) && problem.max_modes() <= 6 {
-        if let Ok(Some(sol)) = solve_exact(problem) {
-            let cost = check(problem, &sol.steps).map_err(SolveError::NoFeasibleRoute)?;
-            return Ok(SolveReport {
-                solution: Solution { steps: sol.steps, cost },
-                initial_cost,
-                first_local_optimum: cost,
-                iterations: 0,
-                elapsed: t0.elapsed(),
-                exact: true,
-            });
-        }
+    if let Some(solution) = small_exact(problem, opts)? {
+        let cost = solution.cost;
+        return Ok(SolveReport {
+            solution,
+            initial_cost,
+            first_local_optimum: cost,
+            iterations: 0,
+            elapsed: t0.elapsed(),
+            exact: true,
+        });
     }
     let net = Net::new(problem);
     let threads = opts.threads.max(1);
-
-    // Construction: nearest neighbour from a seed pool sized to the budget, a space-filling
-    // curve for very large instances, and the initial route if given.
-    let mut starts: Vec<Tour> = Vec::new();
-    let work = (n as f64).powi(2) * problem.max_modes() as f64;
-    if n > 12_000 {
-        if let Some((seq, mode)) = construct::space_filling(&net) {
-            starts.push(Tour::new(&net, seq, mode));
-        }
-    }
-    if starts.is_empty() {
-        // The seed pool is sized to the work (at most ~2·10⁷ arc evaluations) and, under a time
-        // limit, to `START_SHARE` of it.
-        let mut pool_size = ((2e7 / work.max(1.0)) as usize).clamp(1, 64);
-        if let Some(tl) = opts.time_limit {
-            let affordable = tl.as_secs_f64() * START_SHARE / (work.max(1.0) * ARC_SECONDS);
-            pool_size = pool_size.min(affordable as usize).max(1);
-        }
-        let pool = if net.depot != u32::MAX && problem.start().is_some() {
-            vec![0]
-        } else {
-            construct::seed_pool(&net, pool_size)
-        };
-        // Stop early at the deadline, but always end with at least one start.
-        let have_initial = opts.initial.is_some();
-        for f in pool {
-            let limit = if starts.is_empty() && !have_initial { None } else { deadline };
-            match construct::nearest_neighbor(&net, Some(f), limit) {
-                Some((seq, mode)) if seq.len() == net.n => starts.push(Tour::new(&net, seq, mode)),
-                Some(_) => {}
-                None => break,
-            }
-        }
-    }
+    let work = (problem.num_tasks() as f64).powi(2) * problem.max_modes() as f64;
+    let mut starts = construct_starts(&net, problem, opts, work, clock.deadline());
     let eps = 1e-9 * net.typical_arc;
-    // Wider candidate lists pay off under precedence (measured on TSPLIB SOP and SOPLIB at equal
-    // time: 16 beat 10 and 24).
-    let k = if n > 20_000 {
-        8
-    } else if net.has_prec {
-        16
-    } else {
-        10
-    };
-    let mut nb = Neighbors::build(&net, k);
-    // On symmetric one-mode tours the lowest-α neighbours replace the nearest ones when they
-    // are affordable (see `alpha`).
-    if let Some(steps) = alpha::plan(net.n, threads, opts.time_limit.map(|d| d.as_secs_f64())) {
-        let ub = starts.iter().map(|t| t.cost).fold(Cost::INFINITY, Cost::min);
-        if let Some(lists) = alpha::candidates(&net, &nb, steps, ub, threads) {
-            nb = lists;
-        }
-    }
+    let nb = candidate_lists(&net, &starts, opts, threads);
     let ils = Ils::new(&net, &nb, eps);
     // Descend from the best few constructed starts and from the initial route; keep the best
     // local optimum.
     starts.sort_by(|a, b| a.cost.total_cmp(&b.cost));
-    let few = if pool_is_short(opts, work) { 1 } else { 3 };
-    starts.truncate(few);
+    starts.truncate(if pool_is_short(opts, work) { 1 } else { 3 });
     if let Some(steps) = &opts.initial {
         starts.push(tour_from_steps(&net, steps));
     }
     let mut best: Option<Tour> = None;
     for mut t in starts {
-        ils.descend(&mut t, deadline);
+        ils.descend(&mut t, clock.deadline());
         if best.as_ref().is_none_or(|b| t.cost < b.cost) {
             best = Some(t);
         }
     }
     let mut best = best.expect("at least one start");
     let first_local_optimum = best.cost;
+    let iterations = search_epochs(&net, &ils, &mut best, opts, &clock, threads, eps);
+    if !clock.cancelled() {
+        ils.descend(&mut best, clock.deadline());
+    }
+    optimize_final(&net, &mut best, eps);
+    let steps = steps_from_tour(&net, &best);
+    let cost = check(problem, &steps).map_err(SolveError::NoFeasibleRoute)?;
+    let mut solution = Solution { steps, cost };
+    if let (Some(init), Some(ic)) = (&opts.initial, initial_cost) {
+        if ic < solution.cost {
+            solution = Solution { steps: init.clone(), cost: ic };
+        }
+    }
+    Ok(SolveReport { solution, initial_cost, first_local_optimum, iterations, elapsed: t0.elapsed(), exact: false })
+}
 
-    // Iterated local search in epochs.
+/// The exact answer of a problem small enough for the dynamic programme (few tasks, at most
+/// six modes each), or `None` to search heuristically.
+fn small_exact<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<Option<Solution>, SolveError> {
+    if problem.num_tasks() > opts.exact_up_to.min(crate::MAX_EXACT_TASKS) || problem.max_modes() > 6 {
+        return Ok(None);
+    }
+    match solve_exact(problem) {
+        Ok(Some(sol)) => {
+            let cost = check(problem, &sol.steps).map_err(SolveError::NoFeasibleRoute)?;
+            Ok(Some(Solution { steps: sol.steps, cost }))
+        }
+        _ => Ok(None),
+    }
+}
+
+/// Construction: nearest neighbour from a seed pool sized to the budget (`work` arc
+/// evaluations per start), or a space-filling curve for very large instances. Stops early at
+/// the deadline, but always ends with at least one start unless an initial route is given.
+fn construct_starts<C: CostModel>(
+    net: &Net<C>,
+    problem: &Problem<C>,
+    opts: &SolveOptions,
+    work: f64,
+    deadline: Option<Instant>,
+) -> Vec<Tour> {
+    let mut starts: Vec<Tour> = Vec::new();
+    if problem.num_tasks() > 12_000 {
+        if let Some((seq, mode)) = construct::space_filling(net) {
+            starts.push(Tour::new(net, seq, mode));
+            return starts;
+        }
+    }
+    // The seed pool is sized to the work (at most ~2·10⁷ arc evaluations) and, under a time
+    // limit, to `START_SHARE` of it.
+    let mut pool_size = ((2e7 / work.max(1.0)) as usize).clamp(1, 64);
+    if let Some(tl) = opts.time_limit {
+        let affordable = tl.as_secs_f64() * START_SHARE / (work.max(1.0) * ARC_SECONDS);
+        pool_size = pool_size.min(affordable as usize).max(1);
+    }
+    let pool =
+        if net.depot != u32::MAX && problem.start().is_some() { vec![0] } else { construct::seed_pool(net, pool_size) };
+    let have_initial = opts.initial.is_some();
+    for f in pool {
+        let limit = if starts.is_empty() && !have_initial { None } else { deadline };
+        match construct::nearest_neighbor(net, Some(f), limit) {
+            Some((seq, mode)) if seq.len() == net.n => starts.push(Tour::new(net, seq, mode)),
+            Some(_) => {}
+            None => break,
+        }
+    }
+    starts
+}
+
+/// The candidate neighbours of each node: the nearest ones, replaced on symmetric one-mode
+/// tours by the lowest-α ones when they are affordable (see `alpha`).
+fn candidate_lists<C: CostModel>(net: &Net<C>, starts: &[Tour], opts: &SolveOptions, threads: usize) -> Neighbors {
+    // Wider lists pay off under precedence (measured on TSPLIB SOP and SOPLIB at equal time: 16
+    // beat 10 and 24).
+    let k = if net.n > 20_000 {
+        8
+    } else if net.has_prec {
+        16
+    } else {
+        10
+    };
+    let nb = Neighbors::build(net, k);
+    if let Some(steps) = alpha::plan(net.n, threads, opts.time_limit.map(|d| d.as_secs_f64())) {
+        let ub = starts.iter().map(|t| t.cost).fold(Cost::INFINITY, Cost::min);
+        if let Some(lists) = alpha::candidates(net, &nb, steps, ub, threads) {
+            return lists;
+        }
+    }
+    nb
+}
+
+/// The iterated local search in epochs: each thread's chain kicks and descends for an epoch,
+/// then the best chain wins, chains are merged where their tours allow it, and chains that fell
+/// behind adopt the best. Returns the kicks done; `best` is the best tour found.
+fn search_epochs<C: CostModel>(
+    net: &Net<C>,
+    ils: &Ils<'_, '_, C>,
+    best: &mut Tour,
+    opts: &SolveOptions,
+    clock: &Clock,
+    threads: usize,
+    eps: Cost,
+) -> u64 {
+    let t0 = clock.started();
     let mut iterations = 0u64;
     let total_kicks = opts.iterations.unwrap_or(u64::MAX);
     let epochs_planned = 20u64;
@@ -264,20 +314,16 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
     // The search stops a little early to leave time for a last full pass of the local search
     // (don't-look bits leave a few improving moves behind on large instances): 20 µs a node, at
     // most a tenth of the limit (on 100,000 strokes the pass takes about 1 s).
-    let search_end = deadline.map(|d| {
+    let search_end = clock.deadline().map(|d| {
         let reserve =
             opts.time_limit.map_or(Duration::ZERO, |tl| (tl / 10).min(Duration::from_secs_f64(net.n as f64 * 20e-6)));
         d - reserve
     });
-    let merge_chains = threads > 1 && local::uses_or3(&net);
-    let mut chains: Vec<ils::Chain> = (0..threads)
-        .map(|t| ils::Chain::new(&best, opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ t as u64))
-        .collect();
+    let merge_chains = threads > 1 && local::uses_or3(net);
+    let mut chains: Vec<ils::Chain> =
+        (0..threads).map(|t| ils::Chain::new(best, opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ t as u64)).collect();
     while iterations < total_kicks {
-        if search_end.is_some_and(|d| Instant::now() >= d) {
-            break;
-        }
-        if clock.cancelled() {
+        if search_end.is_some_and(|d| Instant::now() >= d) || clock.cancelled() {
             break;
         }
         let epoch_deadline = match (search_end, slice) {
@@ -287,7 +333,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         let left = total_kicks - iterations;
         let kicks_each = per_epoch.min(left.div_ceil(threads as u64));
         let frac = budget_used(opts, t0, iterations).unwrap_or(1.0);
-        let temperature = acceptance_temperature(&net, best.cost, frac);
+        let temperature = acceptance_temperature(net, best.cost, frac);
         let budget = Budget { kicks: kicks_each, deadline: epoch_deadline, hard: search_end, temperature };
         let cancel = clock.cancel_flag().map(|c| &**c);
         let done: u64 = if threads == 1 {
@@ -304,29 +350,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
                 handles.into_iter().map(|h| h.join().expect("solver thread panicked")).sum()
             })
         };
-        // The best chain wins (lowest index on ties); chains that fell behind adopt it.
-        for c in chains.iter() {
-            if c.best.cost < best.cost - eps {
-                best.clone_from(&c.best);
-            }
-        }
-        // Where the chains' tours can be merged, the merge keeps every chain's improvements
-        // instead of only the best chain's.
-        if merge_chains {
-            for c in chains.iter() {
-                if let Some((seq, changed)) = merge::partition_crossover(&net, &best, &c.best, eps) {
-                    let mut child = Tour::new(&net, seq, vec![0; net.n]);
-                    if ils.polish(&mut child, &changed, search_end) && child.cost < best.cost - eps {
-                        best = child;
-                    }
-                }
-            }
-        }
-        for c in chains.iter_mut() {
-            if c.best.cost > best.cost + eps {
-                c.adopt(&best);
-            }
-        }
+        share_best(net, ils, best, &mut chains, merge_chains, search_end, eps);
         iterations += done;
         if let Some(cb) = &opts.progress {
             let fraction = budget_used(opts, t0, iterations).unwrap_or(0.0);
@@ -336,19 +360,41 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
             break;
         }
     }
-    if !clock.cancelled() {
-        ils.descend(&mut best, deadline);
-    }
-    optimize_final(&net, &mut best, eps);
-    let steps = steps_from_tour(&net, &best);
-    let cost = check(problem, &steps).map_err(SolveError::NoFeasibleRoute)?;
-    let mut solution = Solution { steps, cost };
-    if let (Some(init), Some(ic)) = (&opts.initial, initial_cost) {
-        if ic < solution.cost {
-            solution = Solution { steps: init.clone(), cost: ic };
+    iterations
+}
+
+/// The end of an epoch: the best chain wins (lowest index on ties); where the chains' tours can
+/// be merged, the merge keeps every chain's improvements instead of only the best chain's; chains
+/// that fell behind adopt the best.
+fn share_best<C: CostModel>(
+    net: &Net<C>,
+    ils: &Ils<'_, '_, C>,
+    best: &mut Tour,
+    chains: &mut [ils::Chain],
+    merge_chains: bool,
+    search_end: Option<Instant>,
+    eps: Cost,
+) {
+    for c in chains.iter() {
+        if c.best.cost < best.cost - eps {
+            best.clone_from(&c.best);
         }
     }
-    Ok(SolveReport { solution, initial_cost, first_local_optimum, iterations, elapsed: t0.elapsed(), exact: false })
+    if merge_chains {
+        for c in chains.iter() {
+            if let Some((seq, changed)) = merge::partition_crossover(net, best, &c.best, eps) {
+                let mut child = Tour::new(net, seq, vec![0; net.n]);
+                if ils.polish(&mut child, &changed, search_end) && child.cost < best.cost - eps {
+                    *best = child;
+                }
+            }
+        }
+    }
+    for c in chains.iter_mut() {
+        if c.best.cost > best.cost + eps {
+            c.adopt(best);
+        }
+    }
 }
 
 /// Fraction of the budget used, in 0..=1: of the work budget when there is one, else of the
