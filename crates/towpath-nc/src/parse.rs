@@ -89,7 +89,8 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
                 ));
             }
         }
-        if let Some(rapid) = a.motion {
+        if let Some(kind) = a.motion {
+            let rapid = kind.is_rapid();
             // The state during the move: before the line's events if they come after it.
             let (contact, mask) = if timing_after { (before_contact, before_mask) } else { (it.m.contact, it.m.mask) };
             // An arc is laid as its chords: one segment per piece, all on this line.
@@ -109,8 +110,8 @@ pub fn parse(text: &str, machine: &Machine, dialect: &Dialect) -> Result<Program
             }
         }
         // A line that both opens and closes a course would leave an empty on-part block.
-        let toggles = a.events().filter(|e| matches!(e, crate::interp::Event::Contact(_))).count();
-        if has_contact && toggles >= 2 && a.events().any(|e| *e == crate::interp::Event::Contact(true)) {
+        let toggles = a.events().filter(|e| e.is_contact()).count();
+        if has_contact && toggles >= 2 && a.events().any(|e| *e == crate::interp::Event::ContactOn) {
             return Err(NcError::line(i + 1, "roller contact on and off on the same line"));
         }
         match (was, now) {

@@ -319,8 +319,9 @@ fn reverse_span(
         }
         let lexed = a.lexed.clone().unwrap_or_default();
         let undescribed = |words: String| Irreversible::Undescribed { line: j + 1, words };
-        if let Some(rapid) = a.motion {
-            if a.arc {
+        if let Some(kind) = a.motion {
+            let rapid = kind.is_rapid();
+            if kind.is_arc() {
                 return Err(Irreversible::Other(format!(
                     "line {} is an arc: towpath lays arcs only as they are written, forward",
                     j + 1
@@ -602,41 +603,29 @@ fn pair_switches(stations: &mut [Vec<StationItem>]) -> Result<(), Irreversible> 
 fn swapped_event(e: &Event, dialect: &Dialect, lexed: &Lexed) -> String {
     let _ = lexed;
     match *e {
-        Event::Contact(on) => {
-            if on {
-                dialect.contact_off.clone()
-            } else {
-                dialect.contact_on.clone()
-            }
-        }
-        Event::Tow(restart, mask) => {
-            let code = if restart { &dialect.tow_cut } else { &dialect.tow_restart };
-            format!("{code} {}{mask}", dialect.tow_mask_word.to_ascii_uppercase())
-        }
+        Event::ContactOn => dialect.contact_off.clone(),
+        Event::ContactOff => dialect.contact_on.clone(),
+        Event::TowRestart(mask) => tow_event(&dialect.tow_cut, mask, dialect),
+        Event::TowCut(mask) => tow_event(&dialect.tow_restart, mask, dialect),
     }
+}
+
+/// A tow event's text: its code and mask word.
+fn tow_event(code: &str, mask: u64, dialect: &Dialect) -> String {
+    format!("{code} {}{mask}", dialect.tow_mask_word.to_ascii_uppercase())
 }
 
 /// An event line with its code word swapped (restart ↔ cut, contact on ↔ off; every copy of
 /// it), the rest kept.
 fn swap_line_code(line: &str, e: &Event, dialect: &Dialect, codes: &crate::dialect::Codes, lexed: &Lexed) -> String {
     let (from, to) = match *e {
-        Event::Contact(on) => match &codes.contact {
-            Some((c_on, c_off)) => {
-                if on {
-                    (*c_on, dialect.contact_off.clone())
-                } else {
-                    (*c_off, dialect.contact_on.clone())
-                }
-            }
+        Event::ContactOn | Event::ContactOff => match &codes.contact {
+            Some((c_on, _)) if *e == Event::ContactOn => (*c_on, dialect.contact_off.clone()),
+            Some((_, c_off)) => (*c_off, dialect.contact_on.clone()),
             None => return swapped_event(e, dialect, lexed),
         },
-        Event::Tow(restart, _) => {
-            if restart {
-                (codes.restart, dialect.tow_cut.clone())
-            } else {
-                (codes.cut, dialect.tow_restart.clone())
-            }
-        }
+        Event::TowRestart(_) => (codes.restart, dialect.tow_cut.clone()),
+        Event::TowCut(_) => (codes.cut, dialect.tow_restart.clone()),
     };
     // Every word of that code (a line may repeat it), from the end so the spans stay right.
     let spans: Vec<_> =
