@@ -280,14 +280,60 @@ pub fn verify_parsed(
     })
 }
 
-/// One move: (on-part, tows on, feed; NaN for a rapid move).
-type SpanMove = (bool, u64, f64);
+/// How a move is driven: a rapid at the axes' limits, or a feed move at its programmed feed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Pace {
+    /// A rapid move: it has no feed, whatever the modal feed.
+    Rapid,
+    /// A feed move at this feed (always a number: a feed move without a feed is refused by
+    /// the interpreter, and feeds are > 0).
+    Feed(f64),
+}
 
-/// Consecutive moves of a program as points (physical values), with each move's (on-part,
-/// tows, feed).
+impl Pace {
+    /// The pace of a segment.
+    fn of(s: &crate::program::Segment) -> Self {
+        if s.rapid {
+            Pace::Rapid
+        } else {
+            Pace::Feed(s.feed)
+        }
+    }
+
+    /// The feed as a number for messages (NaN for a rapid).
+    fn value(self) -> f64 {
+        match self {
+            Pace::Rapid => f64::NAN,
+            Pace::Feed(f) => f,
+        }
+    }
+}
+
+impl std::fmt::Display for Pace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Pace::Rapid => write!(f, "a rapid"),
+            Pace::Feed(v) => write!(f, "feed {v}"),
+        }
+    }
+}
+
+/// One move of a span, as the verifier compares it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Move {
+    /// The move lays material.
+    on_part: bool,
+    /// Tows on during the move.
+    mask: u64,
+    /// Rapid, or the feed.
+    pace: Pace,
+}
+
+/// Consecutive moves of a program as points (physical values), with each move's contact,
+/// tows and pace.
 struct SpanMotion {
     points: Vec<Vec<f64>>,
-    moves: Vec<SpanMove>,
+    moves: Vec<Move>,
     /// Off-part moves before the first laid one (the approach).
     lead: usize,
     /// Off-part moves after the last laid one (the retract).
@@ -309,8 +355,7 @@ fn motion_of(p: &Program, segs: std::ops::Range<usize>, lead: usize, trail: usiz
     let mut moves = Vec::with_capacity(segs.len());
     for s in &p.segments[segs] {
         points.push(p.point(s.to).to_vec());
-        // A rapid move has no feed: it moves at the machine's speed, whatever the modal feed.
-        moves.push((s.on_part, s.mask, if s.rapid { f64::NAN } else { s.feed }));
+        moves.push(Move { on_part: s.on_part, mask: s.mask, pace: Pace::of(s) });
     }
     SpanMotion { points, moves, lead, trail }
 }
@@ -386,43 +431,34 @@ fn is_forward(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Mac
         }
     }
     for (i, (ma, mb)) in a.moves.iter().zip(&b.moves).enumerate() {
-        if ma.0 != mb.0 || ma.1 != mb.1 || (ma.0 && !same_feed(ma.2, mb.2)) {
+        if ma.on_part != mb.on_part || ma.mask != mb.mask || (ma.on_part && ma.pace != mb.pace) {
             return Err(format!("move {i}: contact, tows or feed differ"));
         }
         // Approach and retract moves keep their motion code and feed too: a roller brought
         // down at a rapid is not the qualified program.
-        if !ma.0 && !same_feed(ma.2, mb.2) {
-            return Err(format!("move {i} (off-part): {} instead of {}", feed_name(mb.2), feed_name(ma.2)));
+        if !ma.on_part && ma.pace != mb.pace {
+            return Err(format!("move {i} (off-part): {} instead of {}", mb.pace, ma.pace));
         }
     }
     Ok(())
 }
 
-fn feed_name(f: f64) -> String {
-    if f.is_nan() {
-        "a rapid".into()
-    } else {
-        format!("feed {f}")
-    }
-}
-
-/// The motion code and feed (NaN: rapid) each move of original course `c`'s span must have
+/// The motion code and feed each move of original course `c`'s span must have
 /// when the course is laid reversed: the original retract, run backwards as the approach,
 /// takes those of the original approach's last move, and the original approach, run
 /// backwards as the retract, those of the original retract's first move; moves of the on-part
 /// block keep their own.
-fn reversed_feeds(p: &Program, c: usize) -> Vec<f64> {
+fn reversed_paces(p: &Program, c: usize) -> Vec<Pace> {
     let course = &p.courses[c];
     let (start, end) = (course.on_part.start as u32, course.on_part.end as u32);
     let segs = &p.segments[course.segments.clone()];
-    let feed = |s: &crate::program::Segment| if s.rapid { f64::NAN } else { s.feed };
-    let last_approach = segs.iter().rev().find(|s| s.line < start).map(feed);
-    let first_retract = segs.iter().find(|s| s.line >= end).map(feed);
+    let last_approach = segs.iter().rev().find(|s| s.line < start).map(Pace::of);
+    let first_retract = segs.iter().find(|s| s.line >= end).map(Pace::of);
     segs.iter()
         .map(|s| match (s.line < start, s.line >= end) {
-            (true, _) => first_retract.unwrap_or(feed(s)),
-            (_, true) => last_approach.unwrap_or(feed(s)),
-            _ => feed(s),
+            (true, _) => first_retract.unwrap_or(Pace::of(s)),
+            (_, true) => last_approach.unwrap_or(Pace::of(s)),
+            _ => Pace::of(s),
         })
         .collect()
 }
@@ -446,7 +482,7 @@ fn is_reversal(
     if n != b.moves.len() {
         return Err(format!("{} moves instead of {}", b.moves.len(), n));
     }
-    let expected = reversed_feeds(orig, oc);
+    let expected = reversed_paces(orig, oc);
     let heading = machine.heading_axis();
     for i in 0..=n {
         let (pa, pb) = (&a.points[n - i], &b.points[i]);
@@ -466,26 +502,22 @@ fn is_reversal(
     }
     for i in 0..n {
         let (ma, mb) = (&a.moves[n - 1 - i], &b.moves[i]);
-        if ma.0 != mb.0 {
+        if ma.on_part != mb.on_part {
             return Err(format!("reversed move {i}: roller contact differs from the original's move {}", n - 1 - i));
         }
-        if ma.1 != mb.1 {
+        if ma.mask != mb.mask {
             return Err(format!(
                 "reversed move {i}: tows on {} where the original's move {} has {} (restart and cut must swap at the same points)",
-                mb.1,
+                mb.mask,
                 n - 1 - i,
-                ma.1
+                ma.mask
             ));
         }
-        if ma.0 && !same_feed(ma.2, mb.2) {
-            return Err(format!("reversed move {i}: feed {} instead of {}", mb.2, ma.2));
+        if ma.on_part && ma.pace != mb.pace {
+            return Err(format!("reversed move {i}: feed {} instead of {}", mb.pace.value(), ma.pace.value()));
         }
-        if !ma.0 && !same_feed(expected[n - 1 - i], mb.2) {
-            return Err(format!(
-                "reversed move {i} (off-part): {} instead of {}",
-                feed_name(mb.2),
-                feed_name(expected[n - 1 - i])
-            ));
+        if !ma.on_part && expected[n - 1 - i] != mb.pace {
+            return Err(format!("reversed move {i} (off-part): {} instead of {}", mb.pace, expected[n - 1 - i]));
         }
     }
     let range = window_range(opt, kc, a.trail, a.lead).unwrap_or(0..0);
@@ -500,10 +532,6 @@ fn same_value(machine: &Machine, i: usize, a: f64, b: f64, turn: f64, tol: f64) 
     } else {
         d.abs() <= tol
     }
-}
-
-fn same_feed(a: f64, b: f64) -> bool {
-    (a.is_nan() && b.is_nan()) || a == b
 }
 
 fn span_text(p: &Program, c: usize) -> String {
