@@ -726,38 +726,7 @@ impl<'a> Interp<'a> {
         let (s, e) = ([start_prog[idx[0]], start_prog[idx[1]]], [self.m.prog[idx[0]], self.m.prog[idx[1]]]);
         let chord = ((e[0] - s[0]).powi(2) + (e[1] - s[1]).powi(2)).sqrt();
         let offsets = [word(centre[0]), word(centre[1])];
-        let c = match (word('R'), offsets) {
-            (Some(_), [Some(_), _] | [_, Some(_)]) => {
-                return Err(NcError::line(n, "an arc with both a radius R and centre offsets"));
-            }
-            (Some(r), _) => {
-                if chord <= 1e-9 {
-                    return Err(NcError::line(n, "an arc given by its radius R must end away from its start"));
-                }
-                let h2 = r * r - chord * chord / 4.0;
-                if h2 < -(ARC_RADIUS_TOLERANCE * chord) {
-                    return Err(NcError::line(
-                        n,
-                        format!(
-                            "the arc's radius R{r} is shorter than half the distance to its end ({:.4})",
-                            chord / 2.0
-                        ),
-                    ));
-                }
-                let h = h2.max(0.0).sqrt();
-                let u = [(e[0] - s[0]) / chord, (e[1] - s[1]) / chord];
-                // Clockwise arcs of at most half a turn have their centre right of the chord.
-                let side = if cw == (r > 0.0) { 1.0 } else { -1.0 };
-                [(s[0] + e[0]) / 2.0 + side * h * u[1], (s[1] + e[1]) / 2.0 - side * h * u[0]]
-            }
-            (None, [None, None]) => {
-                return Err(NcError::line(
-                    n,
-                    format!("an arc needs its centre ({}, {}) or its radius R", centre[0], centre[1]),
-                ));
-            }
-            (None, [i, j]) => [s[0] + i.unwrap_or(0.0), s[1] + j.unwrap_or(0.0)],
-        };
+        let c = arc_centre(n, s, e, cw, word('R'), offsets, centre)?;
         let r0 = ((s[0] - c[0]).powi(2) + (s[1] - c[1]).powi(2)).sqrt();
         let r1 = ((e[0] - c[0]).powi(2) + (e[1] - c[1]).powi(2)).sqrt();
         if r0 <= 1e-9 {
@@ -861,6 +830,50 @@ impl<'a> Interp<'a> {
         }
         None
     }
+}
+
+/// The centre of an arc in its plane from start `s` to end `e`: from its
+/// radius word R (the short way round for R > 0, the long way for R < 0) or its centre
+/// offsets (letters `letters`) from the start.
+fn arc_centre(
+    n: usize,
+    s: [f64; 2],
+    e: [f64; 2],
+    cw: bool,
+    radius: Option<f64>,
+    offsets: [Option<f64>; 2],
+    letters: [char; 2],
+) -> Result<[f64; 2], NcError> {
+    let chord = ((e[0] - s[0]).powi(2) + (e[1] - s[1]).powi(2)).sqrt();
+    Ok(match (radius, offsets) {
+        (Some(_), [Some(_), _] | [_, Some(_)]) => {
+            return Err(NcError::line(n, "an arc with both a radius R and centre offsets"));
+        }
+        (Some(r), _) => {
+            if chord <= 1e-9 {
+                return Err(NcError::line(n, "an arc given by its radius R must end away from its start"));
+            }
+            let h2 = r * r - chord * chord / 4.0;
+            if h2 < -(ARC_RADIUS_TOLERANCE * chord) {
+                return Err(NcError::line(
+                    n,
+                    format!("the arc's radius R{r} is shorter than half the distance to its end ({:.4})", chord / 2.0),
+                ));
+            }
+            let h = h2.max(0.0).sqrt();
+            let u = [(e[0] - s[0]) / chord, (e[1] - s[1]) / chord];
+            // Clockwise arcs of at most half a turn have their centre right of the chord.
+            let side = if cw == (r > 0.0) { 1.0 } else { -1.0 };
+            [(s[0] + e[0]) / 2.0 + side * h * u[1], (s[1] + e[1]) / 2.0 - side * h * u[0]]
+        }
+        (None, [None, None]) => {
+            return Err(NcError::line(
+                n,
+                format!("an arc needs its centre ({}, {}) or its radius R", letters[0], letters[1]),
+            ));
+        }
+        (None, [i, j]) => [s[0] + i.unwrap_or(0.0), s[1] + j.unwrap_or(0.0)],
+    })
 }
 
 fn is_tow(c: &Codes, w: &Word) -> bool {
