@@ -5,6 +5,8 @@
 //! Without one, linear axes labelled X, Y and Z are taken as the tool point's coordinates, as on a
 //! machine under tool-centre-point control. A machine with neither has no kinematics.
 
+use glam::{DMat3, DVec3};
+
 use crate::config::{AxisKind, Machine};
 
 /// One joint of the chain, ready to evaluate.
@@ -21,7 +23,7 @@ struct Joint {
 /// Where the tool point comes from.
 #[derive(Clone, Debug)]
 enum Source {
-    Chain { joints: Vec<Joint>, tool: [f64; 3] },
+    Chain { joints: Vec<Joint>, tool: DVec3 },
     Xyz([Option<usize>; 3]),
 }
 
@@ -30,7 +32,7 @@ enum Source {
 pub struct Kinematics {
     source: Source,
     /// (axis index, point on the axis, unit direction).
-    mandrel: Option<(usize, [f64; 3], [f64; 3])>,
+    mandrel: Option<(usize, DVec3, DVec3)>,
 }
 
 impl Kinematics {
@@ -51,7 +53,7 @@ impl Kinematics {
                             .map(|i| (i, m.axes[i].kind == AxisKind::Linear)),
                     })
                     .collect();
-            Source::Chain { joints, tool: m.tool_offset.unwrap_or([0.0; 3]) }
+            Source::Chain { joints, tool: DVec3::from(m.tool_offset.unwrap_or([0.0; 3])) }
         } else {
             let find = |l: &str| m.axis_index(l).filter(|&i| m.axes[i].kind == AxisKind::Linear);
             let xyz = [find("X"), find("Y"), find("Z")];
@@ -62,24 +64,27 @@ impl Kinematics {
         };
         let mandrel = m.mandrel_axis().map(|i| {
             let a = &m.axes[i];
-            let d = a.direction.unwrap_or([1.0, 0.0, 0.0]);
-            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            (i, a.origin.unwrap_or([0.0; 3]), [d[0] / n, d[1] / n, d[2] / n])
+            let d = DVec3::from(a.direction.unwrap_or([1.0, 0.0, 0.0]));
+            (i, DVec3::from(a.origin.unwrap_or([0.0; 3])), d / d.length())
         });
         Some(Kinematics { source, mandrel })
     }
 
     /// The tool point in the machine frame.
     pub fn world_point(&self, state: &[f64]) -> [f64; 3] {
+        self.world_point_vec(state).to_array()
+    }
+
+    fn world_point_vec(&self, state: &[f64]) -> DVec3 {
         match &self.source {
             Source::Xyz(idx) => {
                 let v = |k: usize| idx[k].and_then(|i| state.get(i).copied()).unwrap_or(0.0);
-                [v(0), v(1), v(2)]
+                DVec3::new(v(0), v(1), v(2))
             }
             Source::Chain { joints, tool } => {
                 // Accumulate the transform as a 3×3 rotation and a translation.
-                let mut r = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-                let mut t = [0.0; 3];
+                let mut r = DMat3::IDENTITY;
+                let mut t = DVec3::ZERO;
                 for j in joints {
                     let (mut theta, mut d) = (j.theta, j.d);
                     if let Some((i, linear)) = j.driver {
@@ -90,16 +95,13 @@ impl Kinematics {
                             theta += q.to_radians();
                         }
                     }
-                    let (st, ct) = theta.sin_cos();
-                    let (sa, ca) = j.alpha.sin_cos();
                     // Standard DH: Rz(theta) Tz(d) Tx(a) Rx(alpha).
-                    let local_r = [[ct, -st * ca, st * sa], [st, ct * ca, -ct * sa], [0.0, sa, ca]];
-                    let local_t = [j.a * ct, j.a * st, d];
-                    let nt = add(t, mat_vec(&r, local_t));
-                    r = mat_mul(&r, &local_r);
-                    t = nt;
+                    let (st, ct) = theta.sin_cos();
+                    let local_t = DVec3::new(j.a * ct, j.a * st, d);
+                    t += r * local_t;
+                    r *= dh_rotation(theta, j.alpha);
                 }
-                add(t, mat_vec(&r, *tool))
+                t + r * *tool
             }
         }
     }
@@ -108,19 +110,19 @@ impl Kinematics {
     /// angle (a positive mandrel move turns the part positively about its direction). Without a
     /// mandrel the part frame is the machine frame.
     pub fn part_point(&self, state: &[f64]) -> [f64; 3] {
-        let p = self.world_point(state);
+        let p = self.world_point_vec(state);
         match self.mandrel {
-            None => p,
+            None => p.to_array(),
             Some((i, o, k)) => {
                 let angle = -state.get(i).copied().unwrap_or(0.0).to_radians();
-                add(o, rotate(sub(p, o), k, angle))
+                (o + rotate(p - o, k, angle)).to_array()
             }
         }
     }
 
     /// The mandrel's axis of rotation (a point on it and its unit direction), if any.
     pub fn mandrel_axis(&self) -> Option<([f64; 3], [f64; 3])> {
-        self.mandrel.map(|(_, o, k)| (o, k))
+        self.mandrel.map(|(_, o, k)| (o.to_array(), k.to_array()))
     }
 }
 
@@ -141,21 +143,22 @@ impl Kinematics {
     /// part: with a DH chain the z axis of the last frame; without one (X/Y/Z axes under
     /// tool-centre-point control) −Z, the head standing above the tool point along +Z.
     pub fn world_tool_axis(&self, state: &[f64]) -> [f64; 3] {
+        self.world_tool_axis_vec(state).to_array()
+    }
+
+    fn world_tool_axis_vec(&self, state: &[f64]) -> DVec3 {
         match &self.source {
-            Source::Xyz(_) => [0.0, 0.0, -1.0],
+            Source::Xyz(_) => DVec3::NEG_Z,
             Source::Chain { joints, .. } => {
-                let mut r = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+                let mut r = DMat3::IDENTITY;
                 for j in joints {
                     let mut theta = j.theta;
                     if let Some((i, false)) = j.driver {
                         theta += state.get(i).copied().unwrap_or(0.0).to_radians();
                     }
-                    let (st, ct) = theta.sin_cos();
-                    let (sa, ca) = j.alpha.sin_cos();
-                    let local_r = [[ct, -st * ca, st * sa], [st, ct * ca, -ct * sa], [0.0, sa, ca]];
-                    r = mat_mul(&r, &local_r);
+                    r *= dh_rotation(theta, j.alpha);
                 }
-                [r[0][2], r[1][2], r[2][2]]
+                r.z_axis
             }
         }
     }
@@ -163,50 +166,27 @@ impl Kinematics {
     /// The tool axis in the part frame ([`Kinematics::world_tool_axis`] turned back by the
     /// mandrel angle, like [`Kinematics::part_point`]).
     pub fn part_tool_axis(&self, state: &[f64]) -> [f64; 3] {
-        let u = self.world_tool_axis(state);
+        let u = self.world_tool_axis_vec(state);
         match self.mandrel {
-            None => u,
-            Some((i, _, k)) => rotate(u, k, -state.get(i).copied().unwrap_or(0.0).to_radians()),
+            None => u.to_array(),
+            Some((i, _, k)) => rotate(u, k, -state.get(i).copied().unwrap_or(0.0).to_radians()).to_array(),
         }
     }
 }
 
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn mat_vec(m: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
-    [
-        m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
-        m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
-        m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2],
-    ]
-}
-
-fn mat_mul(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
-        }
-    }
-    c
+/// The rotation of one standard DH joint, Rz(theta) Rx(alpha) (angles in radians).
+fn dh_rotation(theta: f64, alpha: f64) -> DMat3 {
+    let (st, ct) = theta.sin_cos();
+    let (sa, ca) = alpha.sin_cos();
+    // Rows (ct, −st·ca, st·sa), (st, ct·ca, −ct·sa), (0, sa, ca), given as columns.
+    DMat3::from_cols(DVec3::new(ct, st, 0.0), DVec3::new(-st * ca, ct * ca, sa), DVec3::new(st * sa, -ct * sa, ca))
 }
 
 /// Rodrigues' rotation of `v` by `angle` (radians) about the unit vector `k`.
-fn rotate(v: [f64; 3], k: [f64; 3], angle: f64) -> [f64; 3] {
+fn rotate(v: DVec3, k: DVec3, angle: f64) -> DVec3 {
     let (s, c) = angle.sin_cos();
-    let kv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
-    let cross = [k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2], k[0] * v[1] - k[1] * v[0]];
-    [
-        v[0] * c + cross[0] * s + k[0] * kv * (1.0 - c),
-        v[1] * c + cross[1] * s + k[1] * kv * (1.0 - c),
-        v[2] * c + cross[2] * s + k[2] * kv * (1.0 - c),
-    ]
+    let kv = k.dot(v);
+    v * c + k.cross(v) * s + k * kv * (1.0 - c)
 }
 
 #[cfg(test)]

@@ -10,6 +10,7 @@
 //! rectangle is shrunk by half that tolerance on each side, and shrunk rectangles must overlap
 //! with positive area (bands that only touch do not overlap).
 
+use glam::DVec3;
 use towpath_machine::{Kinematics, Machine};
 
 use crate::error::NcError;
@@ -62,9 +63,9 @@ impl Frame {
         match self {
             Frame::Plan => [p[0], p[1]],
             Frame::Cylinder { origin, dir, e1, e2, radius } => {
-                let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-                let u = dot(d, *dir);
-                let phi = dot(d, *e2).atan2(dot(d, *e1));
+                let d = DVec3::from(p) - DVec3::from(*origin);
+                let u = d.dot(DVec3::from(*dir));
+                let phi = d.dot(DVec3::from(*e2)).atan2(d.dot(DVec3::from(*e1)));
                 [u, radius * phi]
             }
         }
@@ -239,15 +240,15 @@ pub fn frame_for(
     let Some((origin, dir)) = kin.mandrel_axis() else {
         return Ok(Frame::Plan);
     };
+    let (o, k) = (DVec3::from(origin), DVec3::from(dir));
     // e1: any unit vector across the axis.
-    let pick = if dir[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
-    let e1 = normalize(sub(pick, scale(dir, dot(pick, dir))));
-    let e2 = cross(dir, e1);
+    let pick = if k.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+    let across = pick - k * pick.dot(k);
+    let e1 = across / across.length();
+    let e2 = k.cross(e1);
     let radius_of = |i: u32| {
-        let p = kin.part_point(program.point(i));
-        let d = sub(p, origin);
-        let r = sub(d, scale(dir, dot(d, dir)));
-        dot(r, r).sqrt()
+        let d = DVec3::from(kin.part_point(program.point(i))) - o;
+        (d - k * d.dot(k)).length()
     };
     let mut radii: Vec<f64> = Vec::new();
     for (_, i, w) in laid_moves(program, width) {
@@ -272,7 +273,7 @@ pub fn frame_for(
     radii.sort_by(f64::total_cmp);
     // Nothing laid: no footprint depends on the radius.
     let radius = radii.get(radii.len() / 2).copied().unwrap_or(1.0);
-    Ok(Frame::Cylinder { origin, dir, e1, e2, radius })
+    Ok(Frame::Cylinder { origin, dir, e1: e1.to_array(), e2: e2.to_array(), radius })
 }
 
 /// Builds the footprints of every course. Needs the machine's kinematics and a width; refuses a
@@ -429,23 +430,6 @@ fn add_pieces(fp: &mut Footprint, a: [f64; 2], b: [f64; 2], w: f64, pieces: usiz
         fp.quads.push(Quad { c: [a[0] + u[0] * t, a[1] + u[1] * t], u, hl: piece / 2.0, hw });
         fp.move_of.push(m);
     }
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let n = dot(a, a).sqrt();
-    [a[0] / n, a[1] / n, a[2] / n]
 }
 
 #[cfg(test)]

@@ -22,11 +22,6 @@ pub const MAX_ARC_CHORDS: usize = 1_000_000;
 /// Words of an arc: centre offsets from the start (I along X, J along Y, K along Z) or radius.
 const ARC_WORDS: &str = "IJKR";
 
-/// Plane axes of arcs (in the order of the plane codes: XY, ZX, YZ), with the centre-offset
-/// letters of each axis.
-const PLANES: [([char; 2], [char; 2]); 3] =
-    [(['X', 'Y'], ['I', 'J']), (['Z', 'X'], ['K', 'I']), (['Y', 'Z'], ['J', 'K'])];
-
 /// How far (mm) an arc's end may be off its circle, as controllers allow.
 pub const ARC_RADIUS_TOLERANCE: f64 = 0.01;
 
@@ -49,13 +44,10 @@ pub struct Modal {
     pub phys: Vec<f64>,
     /// Incremental distance mode.
     pub incremental: bool,
-    /// Modal motion: `Some(true)` rapid, `Some(false)` feed (linear or arc), `None` not yet set.
-    pub rapid: Option<bool>,
-    /// Modal arc mode: `Some(true)` clockwise, `Some(false)` counter-clockwise, `None` when the
-    /// motion mode is not an arc.
-    pub arc: Option<bool>,
-    /// Modal arc plane: 0 XY, 1 ZX, 2 YZ.
-    pub plane: u8,
+    /// Modal motion mode (`None` until a line sets one).
+    pub motion: Option<MotionMode>,
+    /// Modal arc plane (G17/G18/G19; modal on its own, whatever the motion mode).
+    pub plane: Plane,
     /// Modal feed value and its text.
     pub feed: Option<(f64, NumText)>,
     /// Roller in contact.
@@ -73,9 +65,8 @@ impl Modal {
             text: vec![None; h.len()],
             phys: h,
             incremental: false,
-            rapid: None,
-            arc: None,
-            plane: 0,
+            motion: None,
+            plane: Plane::XY,
             feed: None,
             contact: false,
             mask: 0,
@@ -88,13 +79,115 @@ impl Modal {
     }
 }
 
+/// The plane of an arc, as the dialect's plane codes select it (G17, G18, G19).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Plane {
+    /// The XY plane (G17), centre offsets I and J.
+    #[default]
+    XY,
+    /// The ZX plane (G18), centre offsets K and I.
+    ZX,
+    /// The YZ plane (G19), centre offsets J and K.
+    YZ,
+}
+
+impl Plane {
+    /// The planes in the order of the dialect's `arc_planes` codes.
+    pub const ALL: [Plane; 3] = [Plane::XY, Plane::ZX, Plane::YZ];
+
+    /// The plane's position among the dialect's `arc_planes` codes.
+    pub fn index(self) -> usize {
+        match self {
+            Plane::XY => 0,
+            Plane::ZX => 1,
+            Plane::YZ => 2,
+        }
+    }
+
+    /// The plane's two axis letters (in the order that makes its arcs turn the G2/G3 way) and
+    /// the centre-offset letters of each.
+    pub fn letters(self) -> ([char; 2], [char; 2]) {
+        match self {
+            Plane::XY => (['X', 'Y'], ['I', 'J']),
+            Plane::ZX => (['Z', 'X'], ['K', 'I']),
+            Plane::YZ => (['Y', 'Z'], ['J', 'K']),
+        }
+    }
+}
+
+/// The turning sense of an arc, seen from the positive side of its plane's normal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ArcDir {
+    /// Clockwise (G2).
+    Cw,
+    /// Counter-clockwise (G3).
+    Ccw,
+}
+
+/// A modal motion mode: what axis words on a line without a motion code do.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MotionMode {
+    /// Rapid positioning (G0).
+    Rapid,
+    /// Straight feed move (G1).
+    Linear,
+    /// Arc at the feed (G2/G3), in the modal [`Plane`].
+    Arc(ArcDir),
+}
+
+impl MotionMode {
+    /// True for rapid positioning.
+    pub fn is_rapid(self) -> bool {
+        self == MotionMode::Rapid
+    }
+}
+
+/// The kind of move one line made.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MoveKind {
+    /// A rapid move.
+    Rapid,
+    /// A straight move at the feed.
+    Linear,
+    /// An arc at the feed, in its plane.
+    Arc {
+        /// Its turning sense.
+        dir: ArcDir,
+        /// Its plane.
+        plane: Plane,
+    },
+}
+
+impl MoveKind {
+    /// True for a rapid move.
+    pub fn is_rapid(self) -> bool {
+        self == MoveKind::Rapid
+    }
+
+    /// True for an arc.
+    pub fn is_arc(self) -> bool {
+        matches!(self, MoveKind::Arc { .. })
+    }
+}
+
 /// A contact or tow event.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Event {
-    /// Roller contact on (true) or off.
-    Contact(bool),
-    /// Tows restarted (true) or cut, with their mask.
-    Tow(bool, u64),
+    /// Roller contact on.
+    ContactOn,
+    /// Roller lifted (contact off).
+    ContactOff,
+    /// Tows restarted, with their mask.
+    TowRestart(u64),
+    /// Tows cut, with their mask.
+    TowCut(u64),
+}
+
+impl Event {
+    /// True for roller contact on or off.
+    pub fn is_contact(self) -> bool {
+        matches!(self, Event::ContactOn | Event::ContactOff)
+    }
 }
 
 /// A comment marking a ply or a course.
@@ -111,10 +204,8 @@ pub enum Marker {
 pub struct Applied {
     /// The lexed line (`None` if it could not be lexed; it is then kept as it is).
     pub lexed: Option<Lexed>,
-    /// The line moved the axes: true for rapid, false for feed (linear or arc).
-    pub motion: Option<bool>,
-    /// The move is an arc.
-    pub arc: bool,
+    /// The move the line made, if it moved the axes.
+    pub motion: Option<MoveKind>,
     /// Physical states the move passes through before its end point: an arc's tessellation
     /// (empty for a straight move).
     pub path: Vec<Vec<f64>>,
@@ -139,6 +230,33 @@ impl Applied {
     pub fn events(&self) -> impl Iterator<Item = &Event> {
         self.before.iter().chain(self.after.iter())
     }
+
+    /// True if the line made an arc.
+    pub fn is_arc(&self) -> bool {
+        self.motion.is_some_and(MoveKind::is_arc)
+    }
+}
+
+/// The words of one line, sorted by what they do (the second phase of [`Interp::apply`]).
+#[derive(Default)]
+struct Words<'l> {
+    motion: Option<MotionMode>,
+    plane: Option<Plane>,
+    arc_words: Vec<&'l Word>,
+    /// `Some(true)` incremental, `Some(false)` absolute.
+    distance: Option<bool>,
+    set_pos: bool,
+    feed: Option<&'l Word>,
+    contact_on: bool,
+    contact_off: bool,
+    restart: bool,
+    cut: bool,
+    mask: Option<&'l Word>,
+    axes: Vec<(usize, &'l Word)>,
+    /// The first G word the dialect does not know.
+    other_g: Option<&'l Word>,
+    /// A non-motion code (dwell and such): the line's other words are its parameters.
+    passthrough: bool,
 }
 
 /// Applies lines to a [`Modal`] state.
@@ -213,8 +331,48 @@ impl<'a> Interp<'a> {
     }
 
     /// Applies line `line` (0-based index, for messages) with text `text`.
+    ///
+    /// In phases: lex the line, sort its words, apply its modal words, gather its events, then
+    /// set positions or move (with the events before or after the move, as the dialect has it).
     pub fn apply(&mut self, line: usize, text: &str) -> Result<Applied, NcError> {
         let n = line + 1;
+        let Some(lexed) = self.lex_line(n, text)? else {
+            return Ok(Applied { unknown: true, ..Applied::default() });
+        };
+        let mut out = Applied { marker: self.marker(&lexed.comments), ..Applied::default() };
+        let words = self.read_words(n, &lexed, &mut out)?;
+        let arc_move = self.apply_modal(n, &words, &mut out)?;
+        let events = self.line_events(n, &words)?;
+        out.events = !events.is_empty();
+        if !words.axes.is_empty() && !events.is_empty() && words.set_pos {
+            return Err(NcError::line(n, "tow or contact codes on a set-position line"));
+        }
+        if words.set_pos {
+            if words.axes.is_empty() {
+                return Err(NcError::line(n, "set-position code without axis words"));
+            }
+            for (i, w) in &words.axes {
+                self.m.prog[*i] = w.value;
+                self.m.text[*i] = Some(w.text);
+            }
+            out.set_position = true;
+        } else if !words.axes.is_empty() && words.passthrough {
+            // A dwell or similar: the words are not positions.
+            out.unknown = true;
+        } else if !words.axes.is_empty() || arc_move {
+            self.apply_move(n, &words, arc_move, events, &mut out)?;
+            out.lexed = Some(lexed);
+            return Ok(out);
+        }
+        self.events(n, &events)?;
+        out.before = events;
+        out.lexed = Some(lexed);
+        Ok(out)
+    }
+
+    /// Phase 1 of [`Interp::apply`]: lexes the line. `None` for a line that cannot be lexed
+    /// but may be kept as it is (outside a course, with no axis, G or feed word in the way).
+    fn lex_line(&self, n: usize, text: &str) -> Result<Option<Lexed>, NcError> {
         let lexed = match lex(text, self.dialect.comment_parens, self.dialect.comment_semicolon) {
             Ok(l) => l,
             Err(issue) => {
@@ -229,7 +387,7 @@ impl<'a> Interp<'a> {
                 if self.m.contact || self.m.mask != 0 {
                     return Err(NcError::InCourse { line: n, message: issue.message });
                 }
-                return Ok(Applied { unknown: true, ..Applied::default() });
+                return Ok(None);
             }
         };
         // `X1e308` or `F1.5E3`: a number in exponent notation, which G-code does not have (the
@@ -254,79 +412,64 @@ impl<'a> Interp<'a> {
                 }
             }
         }
-        let mut out = Applied { marker: self.marker(&lexed.comments), ..Applied::default() };
+        Ok(Some(lexed))
+    }
 
+    /// Phase 2 of [`Interp::apply`]: sorts the line's words by what they do, refusing words
+    /// written twice, two codes of one modal group and unknown axes; marks the line unknown if
+    /// it has words the dialect does not know.
+    fn read_words<'l>(&self, n: usize, lexed: &'l Lexed, out: &mut Applied) -> Result<Words<'l>, NcError> {
         let c = &self.codes;
-        // 0 rapid, 1 feed, 2 clockwise arc, 3 counter-clockwise arc.
-        let mut motion_code: Option<u8> = None;
-        let mut plane: Option<u8> = None;
-        let mut arc_words: Vec<&Word> = Vec::new();
-        let mut distance: Option<bool> = None;
-        let mut set_pos = false;
-        let mut feed: Option<&Word> = None;
-        let mut contact_on = false;
-        let mut contact_off = false;
-        let mut restart = false;
-        let mut cut = false;
-        let mut mask: Option<&Word> = None;
-        let mut axes: Vec<(usize, &Word)> = Vec::new();
-        let mut other_g: Option<&Word> = None;
-        let mut passthrough = false;
+        let mut r = Words::default();
         for w in &lexed.words {
             let l = w.letter;
             if l == 'G' {
-                if c.rapid.iter().any(|k| k.matches(l, w.value)) {
-                    set_once(&mut motion_code, 0, n, "two motion codes")?;
-                } else if c.feed.iter().any(|k| k.matches(l, w.value)) {
-                    set_once(&mut motion_code, 1, n, "two motion codes")?;
-                } else if c.arc_cw.iter().any(|k| k.matches(l, w.value)) {
-                    set_once(&mut motion_code, 2, n, "two motion codes")?;
-                } else if c.arc_ccw.iter().any(|k| k.matches(l, w.value)) {
-                    set_once(&mut motion_code, 3, n, "two motion codes")?;
+                if let Some(mode) = self.motion_code(w) {
+                    set_once(&mut r.motion, mode, n, "two motion codes")?;
                 } else if let Some(k) = c.planes.iter().position(|k| k.matches(l, w.value)) {
-                    set_once(&mut plane, k as u8, n, "two arc planes")?;
+                    set_once(&mut r.plane, Plane::ALL[k % 3], n, "two arc planes")?;
                 } else if c.absolute.matches(l, w.value) {
-                    set_once(&mut distance, false, n, "two distance modes")?;
+                    set_once(&mut r.distance, false, n, "two distance modes")?;
                 } else if c.incremental.matches(l, w.value) {
-                    set_once(&mut distance, true, n, "two distance modes")?;
+                    set_once(&mut r.distance, true, n, "two distance modes")?;
                 } else if c.set_position.matches(l, w.value) {
-                    set_pos = true;
+                    r.set_pos = true;
                 } else {
                     if self.non_motion.iter().any(|k| k.matches(l, w.value)) {
-                        passthrough = true;
+                        r.passthrough = true;
                     }
-                    other_g = other_g.or(Some(w));
+                    r.other_g = r.other_g.or(Some(w));
                     out.unknown = true;
                 }
             } else if l == 'M' {
                 match &c.contact {
-                    Some((on, _)) if on.matches(l, w.value) => contact_on = true,
-                    Some((_, off)) if off.matches(l, w.value) => contact_off = true,
-                    _ if c.restart.matches(l, w.value) => restart = true,
-                    _ if c.cut.matches(l, w.value) => cut = true,
+                    Some((on, _)) if on.matches(l, w.value) => r.contact_on = true,
+                    Some((_, off)) if off.matches(l, w.value) => r.contact_off = true,
+                    _ if c.restart.matches(l, w.value) => r.restart = true,
+                    _ if c.cut.matches(l, w.value) => r.cut = true,
                     _ => out.unknown = true,
                 }
             } else if l == c.feed_word {
-                if feed.is_some() {
+                if r.feed.is_some() {
                     return Err(NcError::line(n, format!("two {l} words")));
                 }
-                feed = Some(w);
+                r.feed = Some(w);
             } else if l == c.line_number_word {
                 // Line numbers stay with their line.
             } else if let Some(i) = self.axis_of(l) {
-                if axes.iter().any(|(j, _)| *j == i) {
+                if r.axes.iter().any(|(j, _)| *j == i) {
                     return Err(NcError::line(n, format!("axis {l} is written twice")));
                 }
-                axes.push((i, w));
-            } else if l == c.mask_word && (restart || cut || lexed.words.iter().any(|x| is_tow(c, x))) {
-                mask = Some(w);
+                r.axes.push((i, w));
+            } else if l == c.mask_word && (r.restart || r.cut || lexed.words.iter().any(|x| is_tow(c, x))) {
+                r.mask = Some(w);
             } else if ARC_WORDS.contains(l) {
-                if arc_words.iter().any(|x| x.letter == l) {
+                if r.arc_words.iter().any(|x| x.letter == l) {
                     return Err(NcError::line(n, format!("{l} is written twice")));
                 }
-                arc_words.push(w);
+                r.arc_words.push(w);
             } else {
-                if AXIS_LETTERS.contains(l) && !passthrough && !lexed.words.iter().any(|x| self.is_non_motion(x)) {
+                if AXIS_LETTERS.contains(l) && !r.passthrough && !lexed.words.iter().any(|x| self.is_non_motion(x)) {
                     return Err(NcError::line(
                         n,
                         format!(
@@ -338,192 +481,220 @@ impl<'a> Interp<'a> {
                 out.unknown = true;
             }
         }
-        let passthrough = passthrough || lexed.words.iter().any(|x| self.is_non_motion(x));
+        r.passthrough = r.passthrough || lexed.words.iter().any(|x| self.is_non_motion(x));
+        Ok(r)
+    }
 
-        // Modal words first.
-        if let Some(inc) = distance {
+    /// The motion mode a G word selects, if it is one of the dialect's motion codes.
+    fn motion_code(&self, w: &Word) -> Option<MotionMode> {
+        let c = &self.codes;
+        let is = |codes: &[crate::dialect::Code]| codes.iter().any(|k| k.matches(w.letter, w.value));
+        if is(&c.rapid) {
+            Some(MotionMode::Rapid)
+        } else if is(&c.feed) {
+            Some(MotionMode::Linear)
+        } else if is(&c.arc_cw) {
+            Some(MotionMode::Arc(ArcDir::Cw))
+        } else if is(&c.arc_ccw) {
+            Some(MotionMode::Arc(ArcDir::Ccw))
+        } else {
+            None
+        }
+    }
+
+    /// Phase 3 of [`Interp::apply`]: applies the line's modal words (distance mode, motion
+    /// mode, plane, feed) and checks its axis values' range. Returns whether the line is an
+    /// arc move: axis words in arc mode, or centre words alone (a full circle where it stands).
+    fn apply_modal(&mut self, n: usize, words: &Words, out: &mut Applied) -> Result<bool, NcError> {
+        if let Some(inc) = words.distance {
             self.m.incremental = inc;
             out.modal = true;
         }
-        if let Some(r) = motion_code {
-            if set_pos {
+        if let Some(mode) = words.motion {
+            if words.set_pos {
                 return Err(NcError::line(n, "a set-position code and a motion code on one line"));
             }
-            self.m.rapid = Some(r == 0);
-            self.m.arc = match r {
-                2 => Some(true),
-                3 => Some(false),
-                _ => None,
-            };
+            self.m.motion = Some(mode);
             out.modal = true;
         }
-        if let Some(p) = plane {
+        if let Some(p) = words.plane {
             self.m.plane = p;
             out.modal = true;
         }
-        // An arc: axis words in arc mode, or centre words alone (a full circle where it stands).
-        let arc_move = self.m.arc.is_some()
-            && (!axes.is_empty() || !arc_words.is_empty())
-            && !set_pos
-            && !passthrough
-            && other_g.is_none();
-        if !arc_move && !arc_words.is_empty() {
+        let arc_move = matches!(self.m.motion, Some(MotionMode::Arc(_)))
+            && (!words.axes.is_empty() || !words.arc_words.is_empty())
+            && !words.set_pos
+            && !words.passthrough
+            && words.other_g.is_none();
+        if !arc_move && !words.arc_words.is_empty() {
             // Centre or radius words on a line that is no arc: words towpath does not know.
             out.unknown = true;
         }
-        if let Some(f) = feed {
+        if let Some(f) = words.feed {
             if f.value <= 0.0 || f.value.is_nan() {
                 return Err(NcError::line(n, format!("feed {}{} must be > 0", f.letter, f.text)));
             }
             self.m.feed = Some((f.value, f.text));
             out.modal = true;
         }
-        for (_, w) in &axes {
+        for (_, w) in &words.axes {
             if w.value.abs() > MAX_AXIS_VALUE {
                 return Err(NcError::line(n, format!("{}{} is out of range (|value| ≤ 1e7)", w.letter, w.text)));
             }
         }
+        Ok(arc_move)
+    }
 
-        // Events.
+    /// Phase 4 of [`Interp::apply`]: the line's events, in the order they happen (contact on,
+    /// tow restart or cut, contact off).
+    fn line_events(&self, n: usize, words: &Words) -> Result<Vec<Event>, NcError> {
         let mut events = Vec::new();
-        if contact_on {
-            events.push(Event::Contact(true));
+        if words.contact_on {
+            events.push(Event::ContactOn);
         }
-        if restart && cut {
+        if words.restart && words.cut {
             return Err(NcError::line(n, "a tow restart and a tow cut on one line"));
         }
-        if restart || cut {
-            let Some(mw) = mask else {
+        if words.restart || words.cut {
+            let Some(mw) = words.mask else {
                 return Err(NcError::line(
                     n,
-                    format!("tow {} without a {} mask word", if restart { "restart" } else { "cut" }, c.mask_word),
+                    format!(
+                        "tow {} without a {} mask word",
+                        if words.restart { "restart" } else { "cut" },
+                        self.codes.mask_word
+                    ),
                 ));
             };
             let v = mw.value;
             if !(v >= 1.0 && v.fract() == 0.0 && v < 9.0e15) {
                 return Err(NcError::line(n, format!("tow mask {}{} must be a whole number ≥ 1", mw.letter, mw.text)));
             }
-            events.push(Event::Tow(restart, v as u64));
+            events.push(if words.restart { Event::TowRestart(v as u64) } else { Event::TowCut(v as u64) });
         }
-        if contact_off {
-            events.push(Event::Contact(false));
+        if words.contact_off {
+            events.push(Event::ContactOff);
         }
-        out.events = !events.is_empty();
-        if !axes.is_empty() && !events.is_empty() && set_pos {
-            return Err(NcError::line(n, "tow or contact codes on a set-position line"));
-        }
+        Ok(events)
+    }
 
-        if set_pos {
-            if axes.is_empty() {
-                return Err(NcError::line(n, "set-position code without axis words"));
-            }
-            for (i, w) in &axes {
-                self.m.prog[*i] = w.value;
-                self.m.text[*i] = Some(w.text);
-            }
-            out.set_position = true;
-        } else if !axes.is_empty() && passthrough {
-            // A dwell or similar: the words are not positions.
-            out.unknown = true;
-        } else if !axes.is_empty() || arc_move {
-            if let Some(g) = other_g {
+    /// Phase 5 of [`Interp::apply`]: a move (straight, or an arc as its chords), with the
+    /// line's events before or after it as the dialect's event timing says.
+    fn apply_move(
+        &mut self,
+        n: usize,
+        words: &Words,
+        arc_move: bool,
+        events: Vec<Event>,
+        out: &mut Applied,
+    ) -> Result<(), NcError> {
+        if let Some(g) = words.other_g {
+            return Err(NcError::line(
+                n,
+                format!("G{} with axis words: the dialect knows only rapid and feed moves here", g.text),
+            ));
+        }
+        let Some(mode) = self.m.motion else {
+            return Err(NcError::line(n, "axis words but no motion mode (rapid or feed) is active"));
+        };
+        if !mode.is_rapid() && self.m.feed.is_none() {
+            return Err(NcError::line(n, "a feed move with no feed rate set"));
+        }
+        let timing = self.dialect.event_timing;
+        if timing == EventTiming::Before {
+            self.events(n, &events)?;
+            out.before = events.clone();
+        }
+        if mode.is_rapid() {
+            self.check_rapid(n)?;
+        }
+        // The state where an arc starts (straight moves need none).
+        let start = if arc_move { Some((self.m.prog.clone(), self.m.phys.clone())) } else { None };
+        if arc_move {
+            let laying = if self.codes.contact.is_some() { self.m.contact } else { self.m.mask != 0 };
+            if !laying {
                 return Err(NcError::line(
                     n,
-                    format!("G{} with axis words: the dialect knows only rapid and feed moves here", g.text),
+                    "an arc outside a course's on-part block: towpath keeps arcs only where material is laid \
+                     (off-part motion is regenerated with straight moves)",
                 ));
             }
-            let Some(rapid) = self.m.rapid else {
-                return Err(NcError::line(n, "axis words but no motion mode (rapid or feed) is active"));
-            };
-            if !rapid && self.m.feed.is_none() {
-                return Err(NcError::line(n, "a feed move with no feed rate set"));
-            }
-            let timing = self.dialect.event_timing;
-            if timing == EventTiming::Before {
-                self.events(n, &events)?;
-                out.before = events.clone();
-            }
-            // A rapid move may not touch the part: not with the roller in contact, nor (without
-            // contact codes) with tows on.
-            if rapid {
-                let code = self.dialect.rapid.first().map_or("G0", String::as_str);
-                if self.codes.contact.is_some() && self.m.contact {
-                    return Err(NcError::InCourse {
-                        line: n,
-                        message: format!(
-                            "a rapid move ({code}) while the roller is in contact: rapids do not lay material or \
-                             press the roller; write it as a feed move"
-                        ),
-                    });
-                }
-                if self.m.mask != 0 {
-                    return Err(NcError::InCourse {
-                        line: n,
-                        message: format!(
-                            "a rapid move ({code}) while tows are on (mask {}): rapids do not lay material; write it \
-                             as a feed move",
-                            self.m.mask
-                        ),
-                    });
-                }
-            }
-            // The state where an arc starts (straight moves need none).
-            let start = if arc_move { Some((self.m.prog.clone(), self.m.phys.clone())) } else { None };
-            if arc_move {
-                let laying = if self.codes.contact.is_some() { self.m.contact } else { self.m.mask != 0 };
-                if !laying {
-                    return Err(NcError::line(
-                        n,
-                        "an arc outside a course's on-part block: towpath keeps arcs only where material is laid \
-                         (off-part motion is regenerated with straight moves)",
-                    ));
-                }
-            }
-            for (i, w) in &axes {
-                let (target, text) =
-                    if self.m.incremental { (self.m.prog[*i] + w.value, None) } else { (w.value, Some(w.text)) };
-                // Physical value: the programmed one plus the set-position offset (kept exact
-                // when there is none), or, for a roll-over controller, the short way round.
-                let offset = self.m.phys[*i] - self.m.prog[*i];
-                if !self.m.incremental && self.dialect.rollover && self.kinds[*i].wraps() {
-                    self.m.phys[*i] += wrap(target - self.m.prog[*i]);
-                } else if offset == 0.0 {
-                    self.m.phys[*i] = target;
-                } else {
-                    self.m.phys[*i] = target + offset;
-                }
-                self.m.prog[*i] = target;
-                self.m.text[*i] = text;
-                if self.m.prog[*i].abs() > MAX_AXIS_VALUE || self.m.phys[*i].abs() > 1e9 {
-                    return Err(NcError::line(n, format!("axis {} leaves the accepted range", w.letter)));
-                }
-            }
-            out.motion = Some(rapid);
-            if let (Some(cw), Some((prog, phys))) = (self.m.arc, &start) {
-                out.arc = true;
-                out.path = self.arc_path(n, prog, phys, cw, &arc_words)?;
-                self.chords += out.path.len() + 1;
-                if self.chords > MAX_ARC_CHORDS {
-                    return Err(NcError::line(
-                        n,
-                        format!(
-                            "the program's arcs need more than {MAX_ARC_CHORDS} chords to be followed within \
-                             {ARC_CHORD_TOLERANCE} mm: too many arcs (or arcs too large) for towpath to read"
-                        ),
-                    ));
-                }
-            }
-            if timing == EventTiming::After {
-                self.events(n, &events)?;
-                out.after = events;
-            }
-            out.lexed = Some(lexed);
-            return Ok(out);
         }
-        self.events(n, &events)?;
-        out.before = events;
-        out.lexed = Some(lexed);
-        Ok(out)
+        self.move_axes(n, &words.axes)?;
+        out.motion = Some(match mode {
+            MotionMode::Rapid => MoveKind::Rapid,
+            MotionMode::Linear => MoveKind::Linear,
+            MotionMode::Arc(dir) => MoveKind::Arc { dir, plane: self.m.plane },
+        });
+        if let (MotionMode::Arc(dir), Some((prog, phys))) = (mode, &start) {
+            out.path = self.arc_path(n, prog, phys, dir, &words.arc_words)?;
+            self.chords += out.path.len() + 1;
+            if self.chords > MAX_ARC_CHORDS {
+                return Err(NcError::line(
+                    n,
+                    format!(
+                        "the program's arcs need more than {MAX_ARC_CHORDS} chords to be followed within \
+                         {ARC_CHORD_TOLERANCE} mm: too many arcs (or arcs too large) for towpath to read"
+                    ),
+                ));
+            }
+        }
+        if timing == EventTiming::After {
+            self.events(n, &events)?;
+            out.after = events;
+        }
+        Ok(())
+    }
+
+    /// A rapid move may not touch the part: not with the roller in contact, nor (without
+    /// contact codes) with tows on.
+    fn check_rapid(&self, n: usize) -> Result<(), NcError> {
+        let code = self.dialect.rapid.first().map_or("G0", String::as_str);
+        if self.codes.contact.is_some() && self.m.contact {
+            return Err(NcError::InCourse {
+                line: n,
+                message: format!(
+                    "a rapid move ({code}) while the roller is in contact: rapids do not lay material or press the \
+                     roller; write it as a feed move"
+                ),
+            });
+        }
+        if self.m.mask != 0 {
+            return Err(NcError::InCourse {
+                line: n,
+                message: format!(
+                    "a rapid move ({code}) while tows are on (mask {}): rapids do not lay material; write it as a \
+                     feed move",
+                    self.m.mask
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Moves the axes a line writes: programmed values (absolute or incremental) and physical
+    /// ones (the programmed value plus the set-position offset, kept exact when there is none,
+    /// or, for a roll-over controller, the short way round).
+    fn move_axes(&mut self, n: usize, axes: &[(usize, &Word)]) -> Result<(), NcError> {
+        for (i, w) in axes {
+            let i = *i;
+            let (target, text) =
+                if self.m.incremental { (self.m.prog[i] + w.value, None) } else { (w.value, Some(w.text)) };
+            let offset = self.m.phys[i] - self.m.prog[i];
+            if !self.m.incremental && self.dialect.rollover && self.kinds[i].wraps() {
+                self.m.phys[i] += wrap(target - self.m.prog[i]);
+            } else if offset == 0.0 {
+                self.m.phys[i] = target;
+            } else {
+                self.m.phys[i] = target + offset;
+            }
+            self.m.prog[i] = target;
+            self.m.text[i] = text;
+            if self.m.prog[i].abs() > MAX_AXIS_VALUE || self.m.phys[i].abs() > 1e9 {
+                return Err(NcError::line(n, format!("axis {} leaves the accepted range", w.letter)));
+            }
+        }
+        Ok(())
     }
 
     /// The physical states an arc from `start` to the current state passes through (its end
@@ -533,10 +704,11 @@ impl<'a> Interp<'a> {
         n: usize,
         start_prog: &[f64],
         start_phys: &[f64],
-        cw: bool,
+        dir: ArcDir,
         words: &[&Word],
     ) -> Result<Vec<Vec<f64>>, NcError> {
-        let (labels, centre) = PLANES[self.m.plane as usize % 3];
+        let cw = dir == ArcDir::Cw;
+        let (labels, centre) = self.m.plane.letters();
         let plane_name: String = labels.iter().collect();
         let mut idx = [0usize; 2];
         for k in 0..2 {
@@ -554,38 +726,7 @@ impl<'a> Interp<'a> {
         let (s, e) = ([start_prog[idx[0]], start_prog[idx[1]]], [self.m.prog[idx[0]], self.m.prog[idx[1]]]);
         let chord = ((e[0] - s[0]).powi(2) + (e[1] - s[1]).powi(2)).sqrt();
         let offsets = [word(centre[0]), word(centre[1])];
-        let c = match (word('R'), offsets) {
-            (Some(_), [Some(_), _] | [_, Some(_)]) => {
-                return Err(NcError::line(n, "an arc with both a radius R and centre offsets"));
-            }
-            (Some(r), _) => {
-                if chord <= 1e-9 {
-                    return Err(NcError::line(n, "an arc given by its radius R must end away from its start"));
-                }
-                let h2 = r * r - chord * chord / 4.0;
-                if h2 < -(ARC_RADIUS_TOLERANCE * chord) {
-                    return Err(NcError::line(
-                        n,
-                        format!(
-                            "the arc's radius R{r} is shorter than half the distance to its end ({:.4})",
-                            chord / 2.0
-                        ),
-                    ));
-                }
-                let h = h2.max(0.0).sqrt();
-                let u = [(e[0] - s[0]) / chord, (e[1] - s[1]) / chord];
-                // Clockwise arcs of at most half a turn have their centre right of the chord.
-                let side = if cw == (r > 0.0) { 1.0 } else { -1.0 };
-                [(s[0] + e[0]) / 2.0 + side * h * u[1], (s[1] + e[1]) / 2.0 - side * h * u[0]]
-            }
-            (None, [None, None]) => {
-                return Err(NcError::line(
-                    n,
-                    format!("an arc needs its centre ({}, {}) or its radius R", centre[0], centre[1]),
-                ));
-            }
-            (None, [i, j]) => [s[0] + i.unwrap_or(0.0), s[1] + j.unwrap_or(0.0)],
-        };
+        let c = arc_centre(n, s, e, cw, word('R'), offsets, centre)?;
         let r0 = ((s[0] - c[0]).powi(2) + (s[1] - c[1]).powi(2)).sqrt();
         let r1 = ((e[0] - c[0]).powi(2) + (e[1] - c[1]).powi(2)).sqrt();
         if r0 <= 1e-9 {
@@ -631,13 +772,13 @@ impl<'a> Interp<'a> {
         let has_contact = self.codes.contact.is_some();
         for e in events {
             match *e {
-                Event::Contact(true) => {
+                Event::ContactOn => {
                     if self.m.contact {
                         return Err(NcError::line(n, "roller contact on again without a lift in between"));
                     }
                     self.m.contact = true;
                 }
-                Event::Contact(false) => {
+                Event::ContactOff => {
                     if self.m.mask != 0 {
                         return Err(NcError::line(
                             n,
@@ -646,7 +787,7 @@ impl<'a> Interp<'a> {
                     }
                     self.m.contact = false;
                 }
-                Event::Tow(true, mask) => {
+                Event::TowRestart(mask) => {
                     if has_contact && !self.m.contact {
                         return Err(NcError::line(n, "tows restarted while the roller is lifted"));
                     }
@@ -658,7 +799,7 @@ impl<'a> Interp<'a> {
                     }
                     self.m.mask |= mask;
                 }
-                Event::Tow(false, mask) => {
+                Event::TowCut(mask) => {
                     if self.m.mask == 0 {
                         return Err(NcError::line(n, format!("tow cut (mask {mask}) with no tows on")));
                     }
@@ -689,6 +830,50 @@ impl<'a> Interp<'a> {
         }
         None
     }
+}
+
+/// The centre of an arc in its plane from start `s` to end `e`: from its
+/// radius word R (the short way round for R > 0, the long way for R < 0) or its centre
+/// offsets (letters `letters`) from the start.
+fn arc_centre(
+    n: usize,
+    s: [f64; 2],
+    e: [f64; 2],
+    cw: bool,
+    radius: Option<f64>,
+    offsets: [Option<f64>; 2],
+    letters: [char; 2],
+) -> Result<[f64; 2], NcError> {
+    let chord = ((e[0] - s[0]).powi(2) + (e[1] - s[1]).powi(2)).sqrt();
+    Ok(match (radius, offsets) {
+        (Some(_), [Some(_), _] | [_, Some(_)]) => {
+            return Err(NcError::line(n, "an arc with both a radius R and centre offsets"));
+        }
+        (Some(r), _) => {
+            if chord <= 1e-9 {
+                return Err(NcError::line(n, "an arc given by its radius R must end away from its start"));
+            }
+            let h2 = r * r - chord * chord / 4.0;
+            if h2 < -(ARC_RADIUS_TOLERANCE * chord) {
+                return Err(NcError::line(
+                    n,
+                    format!("the arc's radius R{r} is shorter than half the distance to its end ({:.4})", chord / 2.0),
+                ));
+            }
+            let h = h2.max(0.0).sqrt();
+            let u = [(e[0] - s[0]) / chord, (e[1] - s[1]) / chord];
+            // Clockwise arcs of at most half a turn have their centre right of the chord.
+            let side = if cw == (r > 0.0) { 1.0 } else { -1.0 };
+            [(s[0] + e[0]) / 2.0 + side * h * u[1], (s[1] + e[1]) / 2.0 - side * h * u[0]]
+        }
+        (None, [None, None]) => {
+            return Err(NcError::line(
+                n,
+                format!("an arc needs its centre ({}, {}) or its radius R", letters[0], letters[1]),
+            ));
+        }
+        (None, [i, j]) => [s[0] + i.unwrap_or(0.0), s[1] + j.unwrap_or(0.0)],
+    })
 }
 
 fn is_tow(c: &Codes, w: &Word) -> bool {
@@ -763,7 +948,7 @@ mod tests {
         let d = Dialect::default();
         let m = machine();
         let mut it = Interp::new(&d, &m).unwrap();
-        assert!(it.apply(0, "G0 X10 Y5").unwrap().motion == Some(true));
+        assert!(it.apply(0, "G0 X10 Y5").unwrap().motion == Some(MoveKind::Rapid));
         assert_eq!(it.m.prog, vec![10.0, 5.0, 0.0]);
         it.apply(1, "G91").unwrap();
         it.apply(2, "G1 X1 F100").unwrap();
@@ -833,7 +1018,9 @@ mod tests {
         it.apply(2, "M60 P1").unwrap();
         it.apply(3, "G18").unwrap();
         let a = it.apply(4, "G2 X0 Z10 I-10 K0 F100").unwrap();
-        assert!(a.arc && a.motion == Some(false) && !a.path.is_empty());
+        assert!(
+            a.is_arc() && a.motion == Some(MoveKind::Arc { dir: ArcDir::Cw, plane: Plane::ZX }) && !a.path.is_empty()
+        );
         let mid = &a.path[a.path.len() / 2];
         assert!(mid[0] > 6.0 && mid[2] > 6.0 && mid[1] == 0.0, "{mid:?}");
         for p in &a.path {
@@ -841,12 +1028,12 @@ mod tests {
         }
         // Modal: the next line without a motion code is an arc too (back the other way).
         let b = it.apply(5, "G3 X10 Z0 I0 K-10").unwrap();
-        assert!(b.arc && b.path.iter().all(|p| p[0] > -1e-9 && p[2] > -1e-9));
+        assert!(b.is_arc() && b.path.iter().all(|p| p[0] > -1e-9 && p[2] > -1e-9));
         let c = it.apply(6, "X0 Z10 I-10").unwrap();
-        assert!(c.arc);
+        assert!(c.is_arc());
         // Centre words alone in arc mode: a full circle from where the tool stands.
         let full = it.apply(7, "K-5").unwrap();
-        assert!(full.arc && full.motion == Some(false) && full.path.len() > 8);
+        assert!(full.motion == Some(MoveKind::Arc { dir: ArcDir::Ccw, plane: Plane::ZX }) && full.path.len() > 8);
         assert!(full.path.iter().all(|p| (p[0].hypot(p[2] - 5.0) - 5.0).abs() < 1e-9));
         assert_eq!(it.m.prog, vec![0.0, 0.0, 10.0]);
         // A machine without the plane's axes cannot lay the arc.

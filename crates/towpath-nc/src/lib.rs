@@ -33,7 +33,7 @@ pub use error::NcError;
 pub use footprint::{
     footprints, Footprint, Footprints, Frame, Quad, Width, MAX_PIECES, MAX_WIDTH_PER_SPAN, MIN_WIDTH, OVERLAP_TOLERANCE,
 };
-pub use interp::{Event, Interp, Marker, Modal};
+pub use interp::{Applied, ArcDir, Event, Interp, Marker, Modal, MotionMode, MoveKind, Plane};
 pub use lex::{lex, LexIssue, Lexed, NumText, Word};
 pub use optimize::{
     apply_steps, auto_time_limit, fallback_reason, optimize, Fallback, OptimizeOptions, Optimized, SafetyPair,

@@ -11,7 +11,7 @@
 use towpath_machine::{AxisKind, Machine};
 
 use crate::dialect::Dialect;
-use crate::interp::{Event, Interp, Modal};
+use crate::interp::{Event, Interp, Modal, MotionMode};
 use crate::lex::Lexed;
 use crate::program::Program;
 
@@ -34,11 +34,41 @@ enum Part {
     Retract,
 }
 
+/// How a move of the span is written: at a rapid, or at the feed (its text as written).
+#[derive(Clone, Debug, PartialEq)]
+enum Pace {
+    Rapid,
+    Feed(Option<String>),
+}
+
+impl Part {
+    /// The block of `course` that line `j` of its span is in.
+    fn of(course: &crate::program::Course, j: usize) -> Self {
+        if j < course.on_part.start {
+            Part::Approach
+        } else if j < course.on_part.end {
+            Part::On
+        } else {
+            Part::Retract
+        }
+    }
+}
+
+impl Pace {
+    /// The motion mode the move is written in.
+    fn mode(&self) -> MotionMode {
+        match self {
+            Pace::Rapid => MotionMode::Rapid,
+            Pace::Feed(_) => MotionMode::Linear,
+        }
+    }
+}
+
+/// A move of the span: its block, pace and comments.
 #[derive(Clone, Debug)]
 struct Move {
     part: Part,
-    rapid: bool,
-    feed: Option<String>,
+    pace: Pace,
     comment: Option<String>,
 }
 
@@ -277,6 +307,28 @@ pub(crate) fn check_switch_scope(program: &Program, dialect: &Dialect) -> Result
     Ok(())
 }
 
+/// The span walked forward: its stations (points, `prog[k]` and `text[k]` with the items
+/// written there) and the moves between them (move `k` from station `k` to `k + 1`).
+struct Walk {
+    prog: Vec<Vec<f64>>,
+    text: Vec<Vec<Option<crate::lex::NumText>>>,
+    stations: Vec<Vec<StationItem>>,
+    moves: Vec<Move>,
+}
+
+impl Walk {
+    /// Adds a move to state `to`, with the (swapped) events written before and after it.
+    fn add_move(&mut self, mv: Move, to: &Modal, before: Vec<StationItem>, after: Vec<StationItem>) {
+        if let Some(s) = self.stations.last_mut() {
+            s.extend(before);
+        }
+        self.moves.push(mv);
+        self.prog.push(to.prog.clone());
+        self.text.push(to.text.clone());
+        self.stations.push(after);
+    }
+}
+
 fn reverse_span(
     program: &Program,
     c: usize,
@@ -287,25 +339,54 @@ fn reverse_span(
     let course = &program.courses[c];
     let other = |e: crate::error::NcError| Irreversible::Other(e.to_string());
     let codes = dialect.codes().map_err(other)?;
+    let mut walk = walk_span(program, c, machine, dialect, &codes)?;
+    pair_switches(&mut walk.stations)?;
+    refuse_switches_on(course, &walk.stations)?;
+    let heading = machine.heading_axis();
+    let shift = heading_shift(machine, &walk.prog)?;
+    let values = Values { prog: &walk.prog, text: &walk.text, heading, shift, decimals: dialect.decimals };
+    let lines = if write { write_lines(&walk, &values, machine, dialect) } else { Vec::new() };
+    let n = walk.moves.len();
+    let mut entry = course.span_start.clone();
+    entry.prog = walk.prog[n].clone();
+    entry.text = walk.text[n].clone();
+    for i in 0..machine.dim() {
+        entry.phys[i] = course.span_start.phys[i] - course.span_start.prog[i] + walk.prog[n][i];
+    }
+    if let Some(h) = heading {
+        entry.prog[h] += shift;
+        entry.phys[h] += shift;
+        entry.text[h] = crate::lex::NumText::new(&values.text(n, h));
+    }
+    entry.incremental = false;
+    entry.contact = false;
+    entry.mask = 0;
+    Ok(Reversed { lines, entry, shift })
+}
+
+/// Walks course `c`'s span: stations (points) with their items, and the moves between them;
+/// refuses what cannot be laid reversed.
+fn walk_span(
+    program: &Program,
+    c: usize,
+    machine: &Machine,
+    dialect: &Dialect,
+    codes: &crate::dialect::Codes,
+) -> Result<Walk, Irreversible> {
+    let course = &program.courses[c];
+    let other = |e: crate::error::NcError| Irreversible::Other(e.to_string());
     let mut it = Interp::new(dialect, machine).map_err(other)?;
     it.m = course.span_start.clone();
-    let dim = machine.dim();
-
-    // Walk the span: stations (points) with their items, and the moves between them.
-    let mut prog: Vec<Vec<f64>> = vec![it.m.prog.clone()];
-    let mut text: Vec<Vec<Option<crate::lex::NumText>>> = vec![it.m.text.clone()];
-    let mut stations: Vec<Vec<StationItem>> = vec![Vec::new()];
-    let mut moves: Vec<Move> = Vec::new();
+    let mut walk = Walk {
+        prog: vec![it.m.prog.clone()],
+        text: vec![it.m.text.clone()],
+        stations: vec![Vec::new()],
+        moves: vec![],
+    };
     for j in course.span.clone() {
         let line = program.lines[j].trim_end_matches('\r');
         let a = it.apply(j, line).map_err(other)?;
-        let part = if j < course.on_part.start {
-            Part::Approach
-        } else if j < course.on_part.end {
-            Part::On
-        } else {
-            Part::Retract
-        };
+        let part = Part::of(course, j);
         if a.set_position {
             return Err(Irreversible::Other(format!("line {} sets positions inside the course", j + 1)));
         }
@@ -319,61 +400,52 @@ fn reverse_span(
         }
         let lexed = a.lexed.clone().unwrap_or_default();
         let undescribed = |words: String| Irreversible::Undescribed { line: j + 1, words };
-        if let Some(rapid) = a.motion {
-            if a.arc {
+        if let Some(kind) = a.motion {
+            if kind.is_arc() {
                 return Err(Irreversible::Other(format!(
                     "line {} is an arc: towpath lays arcs only as they are written, forward",
                     j + 1
                 )));
             }
             if a.unknown {
-                return Err(undescribed(unknown_words(&lexed, line, &codes, &it)));
+                return Err(undescribed(unknown_words(&lexed, line, codes, &it)));
             }
-            let event_text = |evs: &[Event]| -> Vec<StationItem> {
-                evs.iter().map(|e| StationItem::Event(swapped_event(e, dialect, &lexed))).collect()
-            };
-            if let Some(s) = stations.last_mut() {
-                s.extend(event_text(&a.before));
-            }
-            moves.push(Move {
-                part,
-                rapid,
-                feed: if rapid { None } else { it.m.feed.as_ref().map(|f| f.1.to_string()) },
-                comment: if lexed.comments.is_empty() { None } else { Some(lexed.comments.join(" ")) },
-            });
-            prog.push(it.m.prog.clone());
-            text.push(it.m.text.clone());
-            stations.push(event_text(&a.after));
+            let pace =
+                if kind.is_rapid() { Pace::Rapid } else { Pace::Feed(it.m.feed.as_ref().map(|f| f.1.to_string())) };
+            let comment = if lexed.comments.is_empty() { None } else { Some(lexed.comments.join(" ")) };
+            let swapped = |evs: &[Event]| evs.iter().map(|e| StationItem::Event(swapped_event(e, dialect))).collect();
+            walk.add_move(Move { part, pace, comment }, &it.m, swapped(&a.before), swapped(&a.after));
         } else if a.events {
             if a.modal {
                 return Err(Irreversible::Other(format!("line {} mixes mode changes and tow or contact codes", j + 1)));
             }
             if a.unknown {
-                return Err(undescribed(unknown_words(&lexed, line, &codes, &it)));
+                return Err(undescribed(unknown_words(&lexed, line, codes, &it)));
             }
-            let evs: Vec<Event> = a.events().copied().collect();
-            if evs.len() != 1 {
+            let [e] = a.events().copied().collect::<Vec<Event>>()[..] else {
                 return Err(Irreversible::Other(format!("line {} has several tow or contact codes", j + 1)));
-            }
-            let item = StationItem::Event(swap_line_code(line, &evs[0], dialect, &codes, &lexed));
-            if let Some(s) = stations.last_mut() {
-                s.push(item);
+            };
+            if let Some(s) = walk.stations.last_mut() {
+                s.push(StationItem::Event(swap_line_code(line, &e, dialect, codes, &lexed)));
             }
         } else {
-            let item = match still_line(a.lexed.as_ref(), line, &codes, a.modal).map_err(undescribed)? {
+            let item = match still_line(a.lexed.as_ref(), line, codes, a.modal).map_err(undescribed)? {
                 // A pure mode change: the reversed moves carry their own modes.
                 Still::Modes => None,
                 Still::Point => Some(StationItem::Line(line.to_string())),
                 Still::Switch(key, on) => Some(StationItem::Switch(key, on, line.to_string(), j)),
             };
-            if let (Some(s), Some(item)) = (stations.last_mut(), item) {
+            if let (Some(s), Some(item)) = (walk.stations.last_mut(), item) {
                 s.push(item);
             }
         }
     }
-    pair_switches(&mut stations)?;
-    // A switch already on where the course starts and switched within it would not be on along
-    // the same stretch reversed (its on and off lines trade places assuming it starts off).
+    Ok(walk)
+}
+
+/// A switch already on where the course starts and switched within it would not be on along
+/// the same stretch reversed (its on and off lines trade places assuming it starts off).
+fn refuse_switches_on(course: &crate::program::Course, stations: &[Vec<StationItem>]) -> Result<(), Irreversible> {
     for item in stations.iter().flatten() {
         if let StationItem::Switch(key, _, text, j) = item {
             if course.switches_on.contains(key) {
@@ -384,67 +456,86 @@ fn reverse_span(
             }
         }
     }
+    Ok(())
+}
 
-    // The heading shift.
-    let mut shift = 0.0;
-    if let Some(h) = machine.heading_axis() {
-        let ax = &machine.axes[h];
-        let lo = prog.iter().map(|p| p[h]).fold(f64::INFINITY, f64::min);
-        let hi = prog.iter().map(|p| p[h]).fold(f64::NEG_INFINITY, f64::max);
-        shift = match ax.kind {
-            AxisKind::Rotary => {
-                let fits =
-                    |s: f64| ax.max.is_none_or(|m| hi + s <= m + 1e-9) && ax.min.is_none_or(|m| lo + s >= m - 1e-9);
-                if fits(180.0) {
-                    180.0
-                } else if fits(-180.0) {
-                    -180.0
-                } else {
-                    return Err(Irreversible::Other(format!(
-                        "turning the heading axis {} by 180° leaves its travel limits",
-                        ax.label
-                    )));
-                }
+/// The heading shift (+180 or −180; 0 without a heading axis): +180 unless that leaves a
+/// rotary heading axis's limits (or, for a continuous one, goes beyond 360°).
+fn heading_shift(machine: &Machine, prog: &[Vec<f64>]) -> Result<f64, Irreversible> {
+    let Some(h) = machine.heading_axis() else { return Ok(0.0) };
+    let ax = &machine.axes[h];
+    let lo = prog.iter().map(|p| p[h]).fold(f64::INFINITY, f64::min);
+    let hi = prog.iter().map(|p| p[h]).fold(f64::NEG_INFINITY, f64::max);
+    Ok(match ax.kind {
+        AxisKind::Rotary => {
+            let fits = |s: f64| ax.max.is_none_or(|m| hi + s <= m + 1e-9) && ax.min.is_none_or(|m| lo + s >= m - 1e-9);
+            if fits(180.0) {
+                180.0
+            } else if fits(-180.0) {
+                -180.0
+            } else {
+                return Err(Irreversible::Other(format!(
+                    "turning the heading axis {} by 180° leaves its travel limits",
+                    ax.label
+                )));
             }
-            _ => {
-                if hi + 180.0 > 360.0 {
-                    -180.0
-                } else {
-                    180.0
-                }
+        }
+        _ => {
+            if hi + 180.0 > 360.0 {
+                -180.0
+            } else {
+                180.0
             }
-        };
-    }
-    let heading = machine.heading_axis();
-    let value_text = |k: usize, i: usize| -> String {
-        let t = text[k][i].as_ref().map(|x| x.as_str());
-        if Some(i) == heading {
+        }
+    })
+}
+
+/// The text of the stations' axis values, reversed: the original text where there is one
+/// (the heading axis's shifted exactly), else the value formatted.
+struct Values<'w> {
+    prog: &'w [Vec<f64>],
+    text: &'w [Vec<Option<crate::lex::NumText>>],
+    heading: Option<usize>,
+    shift: f64,
+    decimals: usize,
+}
+
+impl Values<'_> {
+    /// The text of axis `i` at station `k`.
+    fn text(&self, k: usize, i: usize) -> String {
+        let t = self.text[k][i].as_ref().map(|x| x.as_str());
+        let v = self.prog[k][i];
+        if Some(i) == self.heading {
             match t {
-                Some(t) => shift_decimal(t, shift).unwrap_or_else(|| fmt_num(prog[k][i] + shift, dialect.decimals)),
-                None => fmt_num(prog[k][i] + shift, dialect.decimals),
+                Some(t) => shift_decimal(t, self.shift).unwrap_or_else(|| fmt_num(v + self.shift, self.decimals)),
+                None => fmt_num(v + self.shift, self.decimals),
             }
         } else {
             match t {
                 Some(t) => t.to_string(),
-                None => fmt_num(prog[k][i], dialect.decimals),
+                None => fmt_num(v, self.decimals),
             }
         }
-    };
+    }
+}
 
-    // Motion code and feed for reversed approach and retract moves.
+/// Writes the reversed span: the stations from the last to the first, each station's items
+/// in reverse order, and between them the moves run backwards (the original retract at the
+/// original approach's last motion code and feed, the approach at the retract's first).
+fn write_lines(walk: &Walk, values: &Values, machine: &Machine, dialect: &Dialect) -> Vec<String> {
+    let moves = &walk.moves;
     let last_approach = moves.iter().rev().find(|m| m.part == Part::Approach).cloned();
     let first_retract = moves.iter().find(|m| m.part == Part::Retract).cloned();
     let rapid_code = dialect.rapid.first().cloned().unwrap_or_else(|| "G0".into());
     let feed_code = dialect.feed.first().cloned().unwrap_or_else(|| "G1".into());
-
+    let dim = machine.dim();
     let n = moves.len();
     let mut lines = Vec::new();
-    let stations_to_write = if write { n + 1 } else { 0 };
-    let mut cur: Vec<String> = (0..dim).map(|i| value_text(n, i)).collect();
-    let mut cur_rapid: Option<bool> = None;
-    let mut cur_feed: Option<String> = None;
-    for s in (0..stations_to_write).rev() {
-        for item in stations[s].iter().rev() {
+    let mut cur: Vec<String> = (0..dim).map(|i| values.text(n, i)).collect();
+    let mut cur_mode: Option<MotionMode> = None;
+    let mut cur_feed: Option<&String> = None;
+    for s in (0..=n).rev() {
+        for item in walk.stations[s].iter().rev() {
             match item {
                 StationItem::Line(t) | StationItem::Event(t) | StationItem::Switch(_, _, t, _) => lines.push(t.clone()),
             }
@@ -458,24 +549,23 @@ fn reverse_span(
             Part::Retract => last_approach.as_ref().unwrap_or(mv),
             Part::On => mv,
         };
+        let mode = template.pace.mode();
         let mut words = Vec::new();
-        if cur_rapid != Some(template.rapid) {
-            words.push(if template.rapid { rapid_code.clone() } else { feed_code.clone() });
-            cur_rapid = Some(template.rapid);
+        if cur_mode != Some(mode) {
+            words.push(if mode.is_rapid() { rapid_code.clone() } else { feed_code.clone() });
+            cur_mode = Some(mode);
         }
         for i in 0..dim {
-            let t = value_text(s - 1, i);
-            if t != cur[i] || prog[s - 1][i] != prog[s][i] {
+            let t = values.text(s - 1, i);
+            if t != cur[i] || walk.prog[s - 1][i] != walk.prog[s][i] {
                 words.push(format!("{}{}", machine.axes[i].label.to_ascii_uppercase(), t));
                 cur[i] = t;
             }
         }
-        if !template.rapid {
-            if let Some(f) = &template.feed {
-                if cur_feed.as_ref() != Some(f) {
-                    words.push(format!("{}{}", dialect.feed_word.to_ascii_uppercase(), f));
-                    cur_feed = Some(f.clone());
-                }
+        if let Pace::Feed(Some(f)) = &template.pace {
+            if cur_feed != Some(f) {
+                words.push(format!("{}{}", dialect.feed_word.to_ascii_uppercase(), f));
+                cur_feed = Some(f);
             }
         }
         if !words.iter().any(|w| machine.axes.iter().any(|a| w.starts_with(&a.label.to_ascii_uppercase()))) {
@@ -489,22 +579,7 @@ fn reverse_span(
         }
         lines.push(l);
     }
-
-    let mut entry = course.span_start.clone();
-    entry.prog = prog[n].clone();
-    entry.text = text[n].clone();
-    for i in 0..dim {
-        entry.phys[i] = course.span_start.phys[i] - course.span_start.prog[i] + prog[n][i];
-    }
-    if let Some(h) = heading {
-        entry.prog[h] += shift;
-        entry.phys[h] += shift;
-        entry.text[h] = crate::lex::NumText::new(&value_text(n, h));
-    }
-    entry.incremental = false;
-    entry.contact = false;
-    entry.mask = 0;
-    Ok(Reversed { lines, entry, shift })
+    lines
 }
 
 /// The words of a line the dialect does not describe (or the whole line if it cannot be read).
@@ -599,50 +674,37 @@ fn pair_switches(stations: &mut [Vec<StationItem>]) -> Result<(), Irreversible> 
 }
 
 /// The text of an event split off a motion line: the swapped code and, for tows, the mask.
-fn swapped_event(e: &Event, dialect: &Dialect, lexed: &Lexed) -> String {
-    let _ = lexed;
+fn swapped_event(e: &Event, dialect: &Dialect) -> String {
     match *e {
-        Event::Contact(on) => {
-            if on {
-                dialect.contact_off.clone()
-            } else {
-                dialect.contact_on.clone()
-            }
-        }
-        Event::Tow(restart, mask) => {
-            let code = if restart { &dialect.tow_cut } else { &dialect.tow_restart };
-            format!("{code} {}{mask}", dialect.tow_mask_word.to_ascii_uppercase())
-        }
+        Event::ContactOn => dialect.contact_off.clone(),
+        Event::ContactOff => dialect.contact_on.clone(),
+        Event::TowRestart(mask) => tow_event(&dialect.tow_cut, mask, dialect),
+        Event::TowCut(mask) => tow_event(&dialect.tow_restart, mask, dialect),
     }
+}
+
+/// A tow event's text: its code and mask word.
+fn tow_event(code: &str, mask: u64, dialect: &Dialect) -> String {
+    format!("{code} {}{mask}", dialect.tow_mask_word.to_ascii_uppercase())
 }
 
 /// An event line with its code word swapped (restart ↔ cut, contact on ↔ off; every copy of
 /// it), the rest kept.
 fn swap_line_code(line: &str, e: &Event, dialect: &Dialect, codes: &crate::dialect::Codes, lexed: &Lexed) -> String {
     let (from, to) = match *e {
-        Event::Contact(on) => match &codes.contact {
-            Some((c_on, c_off)) => {
-                if on {
-                    (*c_on, dialect.contact_off.clone())
-                } else {
-                    (*c_off, dialect.contact_on.clone())
-                }
-            }
-            None => return swapped_event(e, dialect, lexed),
+        Event::ContactOn | Event::ContactOff => match &codes.contact {
+            Some((c_on, _)) if *e == Event::ContactOn => (*c_on, dialect.contact_off.clone()),
+            Some((_, c_off)) => (*c_off, dialect.contact_on.clone()),
+            None => return swapped_event(e, dialect),
         },
-        Event::Tow(restart, _) => {
-            if restart {
-                (codes.restart, dialect.tow_cut.clone())
-            } else {
-                (codes.cut, dialect.tow_restart.clone())
-            }
-        }
+        Event::TowRestart(_) => (codes.restart, dialect.tow_cut.clone()),
+        Event::TowCut(_) => (codes.cut, dialect.tow_restart.clone()),
     };
     // Every word of that code (a line may repeat it), from the end so the spans stay right.
     let spans: Vec<_> =
         lexed.words.iter().filter(|w| from.matches(w.letter, w.value)).map(|w| w.span.clone()).collect();
     if spans.is_empty() {
-        return swapped_event(e, dialect, lexed);
+        return swapped_event(e, dialect);
     }
     let mut out = line.to_string();
     for span in spans.into_iter().rev() {

@@ -15,7 +15,7 @@ use towpath_machine::Machine;
 
 use crate::dialect::Dialect;
 use crate::error::NcError;
-use crate::interp::{wrap, Interp, Modal};
+use crate::interp::{wrap, ArcDir, Interp, Modal, MotionMode};
 use crate::program::{join_lines, Item, Program};
 use crate::reverse::{fmt_num, shift_decimal, Reversed};
 use towpath_motion::Planner;
@@ -369,19 +369,19 @@ impl Emitter<'_> {
         if now.incremental != target.incremental {
             modal.push(if target.incremental { d.incremental.clone() } else { d.absolute.clone() });
         }
-        if let Some(r) = target.rapid {
-            if now.rapid != Some(r) || now.arc != target.arc {
-                let code = match target.arc {
-                    Some(true) => d.arc_cw.first(),
-                    Some(false) => d.arc_ccw.first(),
-                    None if r => d.rapid.first(),
-                    None => d.feed.first(),
+        if let Some(mode) = target.motion {
+            if now.motion != Some(mode) {
+                let code = match mode {
+                    MotionMode::Arc(ArcDir::Cw) => d.arc_cw.first(),
+                    MotionMode::Arc(ArcDir::Ccw) => d.arc_ccw.first(),
+                    MotionMode::Rapid => d.rapid.first(),
+                    MotionMode::Linear => d.feed.first(),
                 };
                 modal.push(code.cloned().unwrap_or_default());
             }
         }
         if now.plane != target.plane {
-            modal.push(d.arc_planes.get(target.plane as usize).cloned().unwrap_or_default());
+            modal.push(d.arc_planes.get(target.plane.index()).cloned().unwrap_or_default());
         }
         if let Some((v, t)) = &target.feed {
             if now.feed.as_ref().map(|f| f.0) != Some(*v) {

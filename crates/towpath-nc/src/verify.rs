@@ -206,10 +206,6 @@ pub fn verify_parsed(
     // Precedence.
     let plies_with_courses = orig.plies.iter().filter(|p| !p.courses.is_empty()).count();
     let mut precedence_checked = false;
-    let mut pos = vec![0usize; k];
-    for (i, p) in order.iter().enumerate() {
-        pos[p.course] = i;
-    }
     let width_used = WidthUsed::choose(opts.width, dialect, orig);
     // Ply after ply implies the course rule; without a width that is all there is to check.
     let by_ply_order_alone = opts.strict_plies && fps.is_none() && width_used.width.is_none();
@@ -232,6 +228,36 @@ pub fn verify_parsed(
             check_sets(orig, fps, &order)?;
         }
         precedence_checked = true;
+    }
+    check_ply_order(orig, &order, opts)?;
+
+    let mut inverse = vec![0usize; k];
+    for (i, p) in order.iter().enumerate() {
+        inverse[i] = p.course;
+    }
+    let identity: Vec<usize> = (0..k).collect();
+    let before = measure(orig, machine, dialect, &identity, orig.header_end, orig.footer_start);
+    // The optimized program starts with the original's header and ends with its footer.
+    let footer_len = orig.lines.len() - orig.footer_start;
+    let after = measure(opt, machine, dialect, &inverse, orig.header_end, opt.lines.len() - footer_len);
+    Ok(Verification {
+        courses: k,
+        reversed: order.iter().filter(|p| p.reversed).count(),
+        order,
+        precedence_checked,
+        ply_order_checked: opts.strict_plies,
+        width: width_used,
+        before,
+        after,
+    })
+}
+
+/// The order rules of the options: every ply laid after the one before (`strict_plies`), the
+/// courses of each ply in their original order (`keep_ply_order`).
+fn check_ply_order(orig: &Program, order: &[Placement], opts: &VerifyOptions) -> Result<(), VerifyError> {
+    let mut pos = vec![0usize; orig.courses.len()];
+    for (i, p) in order.iter().enumerate() {
+        pos[p.course] = i;
     }
     if opts.strict_plies {
         for w in orig.plies.iter().filter(|p| !p.courses.is_empty()).collect::<Vec<_>>().windows(2) {
@@ -258,36 +284,63 @@ pub fn verify_parsed(
             }
         }
     }
-
-    let mut inverse = vec![0usize; k];
-    for (i, p) in order.iter().enumerate() {
-        inverse[i] = p.course;
-    }
-    let identity: Vec<usize> = (0..k).collect();
-    let before = measure(orig, machine, dialect, &identity, orig.header_end, orig.footer_start);
-    // The optimized program starts with the original's header and ends with its footer.
-    let footer_len = orig.lines.len() - orig.footer_start;
-    let after = measure(opt, machine, dialect, &inverse, orig.header_end, opt.lines.len() - footer_len);
-    Ok(Verification {
-        courses: k,
-        reversed: order.iter().filter(|p| p.reversed).count(),
-        order,
-        precedence_checked,
-        ply_order_checked: opts.strict_plies,
-        width: width_used,
-        before,
-        after,
-    })
+    Ok(())
 }
 
-/// One move: (on-part, tows on, feed; NaN for a rapid move).
-type SpanMove = (bool, u64, f64);
+/// How a move is driven: a rapid at the axes' limits, or a feed move at its programmed feed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Pace {
+    /// A rapid move: it has no feed, whatever the modal feed.
+    Rapid,
+    /// A feed move at this feed (always a number: a feed move without a feed is refused by
+    /// the interpreter, and feeds are > 0).
+    Feed(f64),
+}
 
-/// Consecutive moves of a program as points (physical values), with each move's (on-part,
-/// tows, feed).
+impl Pace {
+    /// The pace of a segment.
+    fn of(s: &crate::program::Segment) -> Self {
+        if s.rapid {
+            Pace::Rapid
+        } else {
+            Pace::Feed(s.feed)
+        }
+    }
+
+    /// The feed as a number for messages (NaN for a rapid).
+    fn value(self) -> f64 {
+        match self {
+            Pace::Rapid => f64::NAN,
+            Pace::Feed(f) => f,
+        }
+    }
+}
+
+impl std::fmt::Display for Pace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Pace::Rapid => write!(f, "a rapid"),
+            Pace::Feed(v) => write!(f, "feed {v}"),
+        }
+    }
+}
+
+/// One move of a span, as the verifier compares it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Move {
+    /// The move lays material.
+    on_part: bool,
+    /// Tows on during the move.
+    mask: u64,
+    /// Rapid, or the feed.
+    pace: Pace,
+}
+
+/// Consecutive moves of a program as points (physical values), with each move's contact,
+/// tows and pace.
 struct SpanMotion {
     points: Vec<Vec<f64>>,
-    moves: Vec<SpanMove>,
+    moves: Vec<Move>,
     /// Off-part moves before the first laid one (the approach).
     lead: usize,
     /// Off-part moves after the last laid one (the retract).
@@ -309,8 +362,7 @@ fn motion_of(p: &Program, segs: std::ops::Range<usize>, lead: usize, trail: usiz
     let mut moves = Vec::with_capacity(segs.len());
     for s in &p.segments[segs] {
         points.push(p.point(s.to).to_vec());
-        // A rapid move has no feed: it moves at the machine's speed, whatever the modal feed.
-        moves.push((s.on_part, s.mask, if s.rapid { f64::NAN } else { s.feed }));
+        moves.push(Move { on_part: s.on_part, mask: s.mask, pace: Pace::of(s) });
     }
     SpanMotion { points, moves, lead, trail }
 }
@@ -386,43 +438,34 @@ fn is_forward(orig: &Program, oc: usize, opt: &Program, kc: usize, machine: &Mac
         }
     }
     for (i, (ma, mb)) in a.moves.iter().zip(&b.moves).enumerate() {
-        if ma.0 != mb.0 || ma.1 != mb.1 || (ma.0 && !same_feed(ma.2, mb.2)) {
+        if ma.on_part != mb.on_part || ma.mask != mb.mask || (ma.on_part && ma.pace != mb.pace) {
             return Err(format!("move {i}: contact, tows or feed differ"));
         }
         // Approach and retract moves keep their motion code and feed too: a roller brought
         // down at a rapid is not the qualified program.
-        if !ma.0 && !same_feed(ma.2, mb.2) {
-            return Err(format!("move {i} (off-part): {} instead of {}", feed_name(mb.2), feed_name(ma.2)));
+        if !ma.on_part && ma.pace != mb.pace {
+            return Err(format!("move {i} (off-part): {} instead of {}", mb.pace, ma.pace));
         }
     }
     Ok(())
 }
 
-fn feed_name(f: f64) -> String {
-    if f.is_nan() {
-        "a rapid".into()
-    } else {
-        format!("feed {f}")
-    }
-}
-
-/// The motion code and feed (NaN: rapid) each move of original course `c`'s span must have
+/// The motion code and feed each move of original course `c`'s span must have
 /// when the course is laid reversed: the original retract, run backwards as the approach,
 /// takes those of the original approach's last move, and the original approach, run
 /// backwards as the retract, those of the original retract's first move; moves of the on-part
 /// block keep their own.
-fn reversed_feeds(p: &Program, c: usize) -> Vec<f64> {
+fn reversed_paces(p: &Program, c: usize) -> Vec<Pace> {
     let course = &p.courses[c];
     let (start, end) = (course.on_part.start as u32, course.on_part.end as u32);
     let segs = &p.segments[course.segments.clone()];
-    let feed = |s: &crate::program::Segment| if s.rapid { f64::NAN } else { s.feed };
-    let last_approach = segs.iter().rev().find(|s| s.line < start).map(feed);
-    let first_retract = segs.iter().find(|s| s.line >= end).map(feed);
+    let last_approach = segs.iter().rev().find(|s| s.line < start).map(Pace::of);
+    let first_retract = segs.iter().find(|s| s.line >= end).map(Pace::of);
     segs.iter()
         .map(|s| match (s.line < start, s.line >= end) {
-            (true, _) => first_retract.unwrap_or(feed(s)),
-            (_, true) => last_approach.unwrap_or(feed(s)),
-            _ => feed(s),
+            (true, _) => first_retract.unwrap_or(Pace::of(s)),
+            (_, true) => last_approach.unwrap_or(Pace::of(s)),
+            _ => Pace::of(s),
         })
         .collect()
 }
@@ -446,7 +489,7 @@ fn is_reversal(
     if n != b.moves.len() {
         return Err(format!("{} moves instead of {}", b.moves.len(), n));
     }
-    let expected = reversed_feeds(orig, oc);
+    let expected = reversed_paces(orig, oc);
     let heading = machine.heading_axis();
     for i in 0..=n {
         let (pa, pb) = (&a.points[n - i], &b.points[i]);
@@ -466,26 +509,22 @@ fn is_reversal(
     }
     for i in 0..n {
         let (ma, mb) = (&a.moves[n - 1 - i], &b.moves[i]);
-        if ma.0 != mb.0 {
+        if ma.on_part != mb.on_part {
             return Err(format!("reversed move {i}: roller contact differs from the original's move {}", n - 1 - i));
         }
-        if ma.1 != mb.1 {
+        if ma.mask != mb.mask {
             return Err(format!(
                 "reversed move {i}: tows on {} where the original's move {} has {} (restart and cut must swap at the same points)",
-                mb.1,
+                mb.mask,
                 n - 1 - i,
-                ma.1
+                ma.mask
             ));
         }
-        if ma.0 && !same_feed(ma.2, mb.2) {
-            return Err(format!("reversed move {i}: feed {} instead of {}", mb.2, ma.2));
+        if ma.on_part && ma.pace != mb.pace {
+            return Err(format!("reversed move {i}: feed {} instead of {}", mb.pace.value(), ma.pace.value()));
         }
-        if !ma.0 && !same_feed(expected[n - 1 - i], mb.2) {
-            return Err(format!(
-                "reversed move {i} (off-part): {} instead of {}",
-                feed_name(mb.2),
-                feed_name(expected[n - 1 - i])
-            ));
+        if !ma.on_part && expected[n - 1 - i] != mb.pace {
+            return Err(format!("reversed move {i} (off-part): {} instead of {}", mb.pace, expected[n - 1 - i]));
         }
     }
     let range = window_range(opt, kc, a.trail, a.lead).unwrap_or(0..0);
@@ -500,10 +539,6 @@ fn same_value(machine: &Machine, i: usize, a: f64, b: f64, turn: f64, tol: f64) 
     } else {
         d.abs() <= tol
     }
-}
-
-fn same_feed(a: f64, b: f64) -> bool {
-    (a.is_nan() && b.is_nan()) || a == b
 }
 
 fn span_text(p: &Program, c: usize) -> String {
@@ -556,6 +591,10 @@ fn neighbour_cells(cell: &[(i64, Option<i64>)]) -> Vec<Vec<i64>> {
     out
 }
 
+/// A candidate for an optimized course: the original course and its direction, and whether
+/// the span's lines are the same.
+type Candidate = (Placement, bool);
+
 /// Matches every course of `opt` to a course of `orig`: by identical span text and motion, else
 /// by identical motion (written differently), else as a legal reversal. Returns the placements
 /// and, per placement, whether its lines were written anew (reversed, or rewritten forward).
@@ -566,172 +605,234 @@ fn match_courses(
     dialect: &Dialect,
     tol: f64,
 ) -> Result<Vec<Placement>, VerifyError> {
+    let m = Matcher { orig, opt, machine, dialect, tol, index: CourseIndex::new(orig, machine) };
     let k = orig.courses.len();
-    let mut by_text: HashMap<String, Vec<usize>> = HashMap::new();
-    for c in (0..k).rev() {
-        by_text.entry(span_text(orig, c)).or_default().push(c);
-    }
-    let mut by_end: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
-    let mut by_start: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
-    for c in (0..k).rev() {
-        // Keyed by where laying starts and ends: the approach and retract around it may have
-        // taken in transit moves in the optimized program (see `extra`).
-        let key: Vec<i64> = point_cell(machine, laying_point(orig, c, true)).iter().map(|x| x.0).collect();
-        by_end.entry(key).or_default().push(c);
-        let key: Vec<i64> = point_cell(machine, laying_point(orig, c, false)).iter().map(|x| x.0).collect();
-        by_start.entry(key).or_default().push(c);
-    }
-    // Moves each original course has around its laying (approach and retract).
-    let around: Vec<usize> = (0..k).map(|c| orig.courses[c].segments.len() - laying(orig, c).len()).collect();
-    // Candidates near a point, those with the most moves around their laying first: of two
-    // courses that lay the same, the one that also needs a retract (say) must take the
-    // optimized course that has it, leaving the other for one that may not.
-    let near = |map: &HashMap<Vec<i64>, Vec<usize>>, p: &[f64]| -> Vec<usize> {
-        let mut v: Vec<usize> = neighbour_cells(&point_cell(machine, p))
-            .iter()
-            .filter_map(|key| map.get(key))
-            .flat_map(|v| v.iter().copied())
-            .collect();
-        v.sort_unstable_by_key(|&c| (std::cmp::Reverse(around[c]), c));
-        v.dedup();
-        v
-    };
-    // Every original course that optimized course `kc` may be, in order of preference: same
-    // lines, then same motion forward, then a legal reversal. With `unused`, stops at the first
-    // candidate not yet taken. Each comes with "same lines" and, if there is none, why.
-    let candidates = |kc: usize, unused: Option<&[bool]>| -> (Vec<(Placement, bool)>, String) {
-        let mut out: Vec<(Placement, bool)> = Vec::new();
-        let mut detail = String::new();
-        let take = |oc: usize| unused.is_none_or(|u| u[oc]);
-        let done = |out: &Vec<(Placement, bool)>| unused.is_some() && !out.is_empty();
-        let text = span_text(opt, kc);
-        if let Some(cands) = by_text.get(&text) {
-            for &oc in cands.iter().rev() {
-                if !take(oc) {
-                    continue;
-                }
-                match is_forward(orig, oc, opt, kc, machine, tol) {
-                    Ok(()) => {
-                        out.push((Placement { course: oc, reversed: false }, true));
-                        if done(&out) {
-                            return (out, detail);
-                        }
-                    }
-                    Err(e) => detail = format!(": same lines as {} but {e}", orig.course_name(oc)),
-                }
-            }
-        }
-        let start = laying_point(opt, kc, false);
-        for oc in near(&by_start, start) {
-            if !take(oc) || out.iter().any(|x| x.0.course == oc) {
-                continue;
-            }
-            match is_forward(orig, oc, opt, kc, machine, tol) {
-                Ok(()) => {
-                    out.push((Placement { course: oc, reversed: false }, false));
-                    if done(&out) {
-                        return (out, detail);
-                    }
-                }
-                // The first reason kept: the closest candidate, laid forward.
-                Err(e) if detail.is_empty() => detail = format!(": not {} laid forward: {e}", orig.course_name(oc)),
-                Err(_) => {}
-            }
-        }
-        let cands = near(&by_end, start);
-        if cands.is_empty() && detail.is_empty() && out.is_empty() {
-            detail = ": no course of the original stops laying where it starts".into();
-        }
-        for oc in cands {
-            if !take(oc) || out.iter().any(|x| x.0.course == oc) {
-                continue;
-            }
-            match is_reversal(orig, oc, opt, kc, machine, dialect, tol) {
-                Ok(()) => {
-                    out.push((Placement { course: oc, reversed: true }, false));
-                    if done(&out) {
-                        return (out, detail);
-                    }
-                }
-                Err(e) => detail = format!(": not a legal reversal of {}: {e}", orig.course_name(oc)),
-            }
-        }
-        (out, detail)
-    };
     // Greedy in program order; where a course finds every candidate taken (courses alike but
     // for their approach or retract), an augmenting path re-assigns earlier ones.
     let mut unused = vec![true; k];
-    let mut owner: Vec<Option<usize>> = vec![None; k];
-    let mut chosen: Vec<Option<(Placement, bool)>> = vec![None; k];
-    let mut all: HashMap<usize, Vec<(Placement, bool)>> = HashMap::new();
+    let mut a = Assignment { owner: vec![None; k], chosen: vec![None; k], all: HashMap::new() };
     for kc in 0..k {
-        let (first, detail) = candidates(kc, Some(&unused));
+        let (first, detail) = m.candidates(kc, Some(&unused));
         if let Some(&(p, text)) = first.first() {
             unused[p.course] = false;
-            owner[p.course] = Some(kc);
-            chosen[kc] = Some((p, text));
+            a.owner[p.course] = Some(kc);
+            a.chosen[kc] = Some((p, text));
             continue;
         }
-        let (list, _) = candidates(kc, None);
+        let (list, _) = m.candidates(kc, None);
         if list.is_empty() {
             return Err(VerifyError::Unmatched { line: opt.courses[kc].on_part.start + 1, detail });
         }
-        all.insert(kc, list);
+        a.all.insert(kc, list);
         let mut seen = vec![false; k];
-        if !augment(kc, &mut seen, &mut owner, &mut chosen, &mut all, &candidates) {
+        if !a.augment(kc, &mut seen, &m) {
             return Err(VerifyError::Unmatched {
                 line: opt.courses[kc].on_part.start + 1,
                 detail: ": every course of the original it could be is laid elsewhere".into(),
             });
         }
-        for (u, o) in unused.iter_mut().zip(&owner) {
+        for (u, o) in unused.iter_mut().zip(&a.owner) {
             *u = o.is_none();
         }
     }
     let mut order = Vec::with_capacity(k);
-
-    for c in chosen {
-        let Some((p, text)) = c else {
+    for c in a.chosen {
+        let Some((p, _)) = c else {
             return Err(VerifyError::Missing(String::from("a course")));
         };
         order.push(p);
-        let _ = text;
     }
-    if let Some(c) = owner.iter().position(Option::is_none) {
+    if let Some(c) = a.owner.iter().position(Option::is_none) {
         return Err(VerifyError::Missing(orig.course_name(c)));
     }
     Ok(order)
 }
 
-/// Kuhn's augmenting path: gives optimized course `kc` one of its candidates, moving the
-/// courses that hold them to other candidates of theirs if need be.
-fn augment<F>(
-    kc: usize,
-    seen: &mut [bool],
-    owner: &mut [Option<usize>],
-    chosen: &mut [Option<(Placement, bool)>],
-    all: &mut HashMap<usize, Vec<(Placement, bool)>>,
-    candidates: &F,
-) -> bool
-where
-    F: Fn(usize, Option<&[bool]>) -> (Vec<(Placement, bool)>, String),
-{
-    let list = all.entry(kc).or_insert_with(|| candidates(kc, None).0).clone();
-    for (p, text) in list {
-        if std::mem::replace(&mut seen[p.course], true) {
-            continue;
+/// The original's courses indexed for matching: by span text, and by the grid cell where
+/// their laying starts and ends.
+struct CourseIndex {
+    by_text: HashMap<String, Vec<usize>>,
+    by_start: HashMap<Vec<i64>, Vec<usize>>,
+    by_end: HashMap<Vec<i64>, Vec<usize>>,
+    /// Moves each original course has around its laying (approach and retract).
+    around: Vec<usize>,
+}
+
+impl CourseIndex {
+    fn new(orig: &Program, machine: &Machine) -> Self {
+        let k = orig.courses.len();
+        let mut by_text: HashMap<String, Vec<usize>> = HashMap::new();
+        for c in (0..k).rev() {
+            by_text.entry(span_text(orig, c)).or_default().push(c);
         }
-        let free = match owner[p.course] {
-            None => true,
-            Some(other) => augment(other, seen, owner, chosen, all, candidates),
-        };
-        if free {
-            owner[p.course] = Some(kc);
-            chosen[kc] = Some((p, text));
-            return true;
+        let mut by_end: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
+        let mut by_start: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
+        for c in (0..k).rev() {
+            // Keyed by where laying starts and ends: the approach and retract around it may have
+            // taken in transit moves in the optimized program (see `window`).
+            let key: Vec<i64> = point_cell(machine, laying_point(orig, c, true)).iter().map(|x| x.0).collect();
+            by_end.entry(key).or_default().push(c);
+            let key: Vec<i64> = point_cell(machine, laying_point(orig, c, false)).iter().map(|x| x.0).collect();
+            by_start.entry(key).or_default().push(c);
         }
+        let around = (0..k).map(|c| orig.courses[c].segments.len() - laying(orig, c).len()).collect();
+        CourseIndex { by_text, by_start, by_end, around }
     }
-    false
+
+    /// Candidates near a point, those with the most moves around their laying first: of two
+    /// courses that lay the same, the one that also needs a retract (say) must take the
+    /// optimized course that has it, leaving the other for one that may not.
+    fn near(&self, map: &HashMap<Vec<i64>, Vec<usize>>, machine: &Machine, p: &[f64]) -> Vec<usize> {
+        let mut v: Vec<usize> = neighbour_cells(&point_cell(machine, p))
+            .iter()
+            .filter_map(|key| map.get(key))
+            .flat_map(|v| v.iter().copied())
+            .collect();
+        v.sort_unstable_by_key(|&c| (std::cmp::Reverse(self.around[c]), c));
+        v.dedup();
+        v
+    }
+}
+
+/// What matching compares: the two programs and the index of the original's courses.
+struct Matcher<'a> {
+    orig: &'a Program,
+    opt: &'a Program,
+    machine: &'a Machine,
+    dialect: &'a Dialect,
+    tol: f64,
+    index: CourseIndex,
+}
+
+/// Candidates found so far for one optimized course, and why the closest others failed.
+struct Found<'u> {
+    out: Vec<Candidate>,
+    detail: String,
+    /// With a mask of the original courses not yet taken, stops at the first such candidate.
+    unused: Option<&'u [bool]>,
+}
+
+impl Found<'_> {
+    fn takes(&self, oc: usize) -> bool {
+        self.unused.is_none_or(|u| u[oc]) && !self.out.iter().any(|x| x.0.course == oc)
+    }
+
+    /// Adds a candidate; true when the search may stop.
+    fn push(&mut self, c: Candidate) -> bool {
+        self.out.push(c);
+        self.unused.is_some()
+    }
+}
+
+impl Matcher<'_> {
+    /// Every original course that optimized course `kc` may be, in order of preference: same
+    /// lines, then same motion forward, then a legal reversal. With `unused`, stops at the first
+    /// candidate not yet taken. Each comes with "same lines" and, if there is none, why.
+    fn candidates(&self, kc: usize, unused: Option<&[bool]>) -> (Vec<Candidate>, String) {
+        let mut f = Found { out: Vec::new(), detail: String::new(), unused };
+        if self.same_lines(kc, &mut f) || self.forward_near(kc, &mut f) {
+            return (f.out, f.detail);
+        }
+        self.reversed_near(kc, &mut f);
+        (f.out, f.detail)
+    }
+
+    /// Original courses with the same span text, laid forward.
+    fn same_lines(&self, kc: usize, f: &mut Found) -> bool {
+        let Some(cands) = self.index.by_text.get(&span_text(self.opt, kc)) else { return false };
+        for &oc in cands.iter().rev() {
+            if !f.takes(oc) {
+                continue;
+            }
+            match is_forward(self.orig, oc, self.opt, kc, self.machine, self.tol) {
+                Ok(()) => {
+                    if f.push((Placement { course: oc, reversed: false }, true)) {
+                        return true;
+                    }
+                }
+                Err(e) => f.detail = format!(": same lines as {} but {e}", self.orig.course_name(oc)),
+            }
+        }
+        false
+    }
+
+    /// Original courses that start laying where `kc` does, with the same motion forward.
+    fn forward_near(&self, kc: usize, f: &mut Found) -> bool {
+        let start = laying_point(self.opt, kc, false);
+        for oc in self.index.near(&self.index.by_start, self.machine, start) {
+            if !f.takes(oc) {
+                continue;
+            }
+            match is_forward(self.orig, oc, self.opt, kc, self.machine, self.tol) {
+                Ok(()) => {
+                    if f.push((Placement { course: oc, reversed: false }, false)) {
+                        return true;
+                    }
+                }
+                // The first reason kept: the closest candidate, laid forward.
+                Err(e) if f.detail.is_empty() => {
+                    f.detail = format!(": not {} laid forward: {e}", self.orig.course_name(oc))
+                }
+                Err(_) => {}
+            }
+        }
+        false
+    }
+
+    /// Original courses that stop laying where `kc` starts, legally reversed.
+    fn reversed_near(&self, kc: usize, f: &mut Found) -> bool {
+        let start = laying_point(self.opt, kc, false);
+        let cands = self.index.near(&self.index.by_end, self.machine, start);
+        if cands.is_empty() && f.detail.is_empty() && f.out.is_empty() {
+            f.detail = ": no course of the original stops laying where it starts".into();
+        }
+        for oc in cands {
+            if !f.takes(oc) {
+                continue;
+            }
+            match is_reversal(self.orig, oc, self.opt, kc, self.machine, self.dialect, self.tol) {
+                Ok(()) => {
+                    if f.push((Placement { course: oc, reversed: true }, false)) {
+                        return true;
+                    }
+                }
+                Err(e) => f.detail = format!(": not a legal reversal of {}: {e}", self.orig.course_name(oc)),
+            }
+        }
+        false
+    }
+}
+
+/// The matching so far: which optimized course holds each original course, the candidate
+/// each optimized course holds, and every candidate of the courses that needed more than the
+/// first.
+struct Assignment {
+    owner: Vec<Option<usize>>,
+    chosen: Vec<Option<Candidate>>,
+    all: HashMap<usize, Vec<Candidate>>,
+}
+
+impl Assignment {
+    /// Kuhn's augmenting path: gives optimized course `kc` one of its candidates, moving the
+    /// courses that hold them to other candidates of theirs if need be.
+    fn augment(&mut self, kc: usize, seen: &mut [bool], m: &Matcher) -> bool {
+        let list = self.all.entry(kc).or_insert_with(|| m.candidates(kc, None).0).clone();
+        for (p, text) in list {
+            if std::mem::replace(&mut seen[p.course], true) {
+                continue;
+            }
+            let free = match self.owner[p.course] {
+                None => true,
+                Some(other) => self.augment(other, seen, m),
+            };
+            if free {
+                self.owner[p.course] = Some(kc);
+                self.chosen[kc] = Some((p, text));
+                return true;
+            }
+        }
+        false
+    }
 }
 
 /// Most (rectangle, cell) incidences the verifier's grids hold; their cells grow until the
