@@ -6,6 +6,7 @@ use towpath_seq::{CostModel, End, Metric, Problem, StateId, TaskId};
 
 use crate::instance::{Instance, Kind, LoadedProblem, Numbering};
 use crate::json::{JsonEnd, JsonMetric, JsonMode, JsonProblem, JsonStates, JsonTask};
+use crate::metric::FileMetric;
 
 /// How [`Instance::to_json`] writes the transition costs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -143,15 +144,15 @@ fn structure<C: CostModel>(p: &Problem<C>, ids: &[String], states: JsonStates, n
     }
 }
 
-fn json_metric(m: Metric) -> JsonMetric {
+fn json_metric(m: FileMetric) -> JsonMetric {
     match m {
-        Metric::Euclidean => JsonMetric::Euclidean,
-        Metric::EuclideanNint => JsonMetric::EuclideanNint,
-        Metric::EuclideanCeil => JsonMetric::EuclideanCeil,
-        Metric::Att => JsonMetric::Att,
-        Metric::ManhattanNint => JsonMetric::ManhattanNint,
-        Metric::Manhattan => JsonMetric::Manhattan,
-        Metric::MaximumNint => JsonMetric::MaximumNint,
-        Metric::Geo => JsonMetric::Geo,
+        FileMetric::Plain(Metric::Euclidean) => JsonMetric::Euclidean,
+        FileMetric::Plain(Metric::EuclideanNint) => JsonMetric::EuclideanNint,
+        FileMetric::Plain(Metric::EuclideanCeil) => JsonMetric::EuclideanCeil,
+        FileMetric::Att => JsonMetric::Att,
+        FileMetric::Plain(Metric::ManhattanNint) => JsonMetric::ManhattanNint,
+        FileMetric::Plain(Metric::Manhattan) => JsonMetric::Manhattan,
+        FileMetric::Plain(Metric::MaximumNint) => JsonMetric::MaximumNint,
+        FileMetric::Geo => JsonMetric::Geo,
     }
 }

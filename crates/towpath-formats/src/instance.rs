@@ -3,6 +3,7 @@
 
 use std::fmt;
 
+use crate::metric::FileMetric;
 use serde::Serialize;
 use towpath_seq::{CostModel, End, MatrixCost, PointCost, Problem, Step, TaskId, Violation};
 
@@ -53,7 +54,7 @@ pub enum LoadedProblem {
     /// Costs from an explicit matrix.
     Matrix(Problem<MatrixCost>),
     /// Costs computed from point coordinates.
-    Points(Problem<PointCost>),
+    Points(Problem<PointCost<FileMetric>>),
 }
 
 /// Runs an expression on the problem inside a [`LoadedProblem`], whichever cost model it has:

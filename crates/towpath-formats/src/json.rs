@@ -8,6 +8,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
+use crate::metric::FileMetric;
 use serde::{Deserialize, Serialize};
 use towpath_seq::{End, MatrixCost, Metric, Mode, ModelError, PointCost, Problem, ProblemBuilder, StateId, TaskId};
 
@@ -87,16 +88,16 @@ pub enum JsonMetric {
 }
 
 impl JsonMetric {
-    fn metric(self) -> Metric {
+    fn metric(self) -> FileMetric {
         match self {
-            JsonMetric::Euclidean => Metric::Euclidean,
-            JsonMetric::EuclideanNint => Metric::EuclideanNint,
-            JsonMetric::EuclideanCeil => Metric::EuclideanCeil,
-            JsonMetric::Att => Metric::Att,
-            JsonMetric::Manhattan => Metric::Manhattan,
-            JsonMetric::ManhattanNint => Metric::ManhattanNint,
-            JsonMetric::MaximumNint => Metric::MaximumNint,
-            JsonMetric::Geo => Metric::Geo,
+            JsonMetric::Euclidean => FileMetric::Plain(Metric::Euclidean),
+            JsonMetric::EuclideanNint => FileMetric::Plain(Metric::EuclideanNint),
+            JsonMetric::EuclideanCeil => FileMetric::Plain(Metric::EuclideanCeil),
+            JsonMetric::Att => FileMetric::Att,
+            JsonMetric::Manhattan => FileMetric::Plain(Metric::Manhattan),
+            JsonMetric::ManhattanNint => FileMetric::Plain(Metric::ManhattanNint),
+            JsonMetric::MaximumNint => FileMetric::Plain(Metric::MaximumNint),
+            JsonMetric::Geo => FileMetric::Geo,
         }
     }
 }

@@ -28,6 +28,7 @@ mod json;
 pub mod json_locate;
 mod json_shape;
 mod matrix;
+mod metric;
 mod sets;
 mod text;
 mod tour;
@@ -42,6 +43,7 @@ pub use json::{
     parse_json, parse_json_problem, write_json, JsonEnd, JsonMetric, JsonMode, JsonProblem, JsonStates, JsonTask,
 };
 pub use matrix::WeightFormat;
+pub use metric::FileMetric;
 pub use tour::{parse_tour, Tour};
 pub use tsplib::parse_tsplib;
 

@@ -23,25 +23,26 @@ use crate::error::{ErrorKind, FormatError};
 use crate::instance::{FixedEdge, Instance, Kind, LoadedProblem, Numbering};
 use crate::matrix::parse_integer;
 use crate::matrix::{read_matrix, WeightFormat};
+use crate::metric::FileMetric;
 use crate::sets::{read_ordering, read_sets, read_start};
 use crate::text::{lex, Document, Section};
 
 /// The coordinate edge-weight types: (name, coordinates per node, metric).
-const COORD_TYPES: &[(&str, usize, Metric)] = &[
-    ("EUC_2D", 2, Metric::EuclideanNint),
-    ("EUC_3D", 3, Metric::EuclideanNint),
-    ("CEIL_2D", 2, Metric::EuclideanCeil),
-    ("ATT", 2, Metric::Att),
-    ("GEO", 2, Metric::Geo),
-    ("MAN_2D", 2, Metric::ManhattanNint),
-    ("MAN_3D", 3, Metric::ManhattanNint),
-    ("MAX_2D", 2, Metric::MaximumNint),
-    ("MAX_3D", 3, Metric::MaximumNint),
+const COORD_TYPES: &[(&str, usize, FileMetric)] = &[
+    ("EUC_2D", 2, FileMetric::Plain(Metric::EuclideanNint)),
+    ("EUC_3D", 3, FileMetric::Plain(Metric::EuclideanNint)),
+    ("CEIL_2D", 2, FileMetric::Plain(Metric::EuclideanCeil)),
+    ("ATT", 2, FileMetric::Att),
+    ("GEO", 2, FileMetric::Geo),
+    ("MAN_2D", 2, FileMetric::Plain(Metric::ManhattanNint)),
+    ("MAN_3D", 3, FileMetric::Plain(Metric::ManhattanNint)),
+    ("MAX_2D", 2, FileMetric::Plain(Metric::MaximumNint)),
+    ("MAX_3D", 3, FileMetric::Plain(Metric::MaximumNint)),
 ];
 
 /// Costs as read: points or a full matrix (with its -1 entries and their lines).
 enum Costs {
-    Points(PointCost),
+    Points(PointCost<FileMetric>),
     Matrix { n: usize, data: Vec<f64>, minus_ones: Vec<(usize, usize, usize)> },
 }
 
@@ -262,7 +263,7 @@ fn number(x: f64) -> String {
 /// could exceed 2⁵³ and no longer add up exactly, naming the two states farthest apart (by
 /// `label`) and pointing at `line`.
 pub(crate) fn check_exact(
-    cost: &PointCost,
+    cost: &PointCost<FileMetric>,
     moves: usize,
     label: &dyn Fn(u32) -> String,
     line: usize,

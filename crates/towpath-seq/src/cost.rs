@@ -192,48 +192,61 @@ fn finite_bound(data: &[Cost]) -> Cost {
     data.iter().filter(|c| c.is_finite()).fold(0.0, |m: Cost, c| m.max(c.abs()))
 }
 
+/// How a distance between two points becomes a cost: the inner loop of every point-based
+/// problem. [`Metric`] holds the usual ones; a reader of a file format with its own conventions
+/// (TSPLIB's `ATT` and `GEO`, in `towpath-formats`) supplies its own, and the solver is compiled
+/// for it with no dynamic dispatch.
+pub trait PointMetric: Copy + PartialEq + std::fmt::Debug + Send + Sync + 'static {
+    /// The cost from point `from` to point `to` of `points` (must equal the cost back). Indices
+    /// rather than coordinates, so that a metric may tell a state from another at the same
+    /// place (TSPLIB's `GEO` prices those 1, not 0).
+    fn cost(self, points: &[[f64; 3]], from: usize, to: usize) -> Cost;
+
+    /// True when every cost is an integer.
+    fn is_integral(self) -> bool;
+
+    /// A bound on the cost between any two points whose coordinates differ by at most
+    /// `extent` along each axis (infinite if an extent is).
+    fn bound(self, extent: [f64; 3]) -> Cost;
+
+    /// True when the coordinates are positions in space, so that a spatial tree over them finds
+    /// near states (false for angles such as latitude and longitude).
+    fn is_spatial(self) -> bool {
+        true
+    }
+}
+
 /// How a distance between two points is turned into a cost.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Metric {
     /// Euclidean distance, unrounded.
     Euclidean,
-    /// Euclidean distance rounded to the nearest integer (TSPLIB `EUC_2D`, `EUC_3D`).
+    /// Euclidean distance rounded to the nearest integer, halves up (TSPLIB `EUC_2D`, `EUC_3D`).
     EuclideanNint,
     /// Euclidean distance rounded up (TSPLIB `CEIL_2D`).
     EuclideanCeil,
-    /// TSPLIB pseudo-Euclidean `ATT` distance.
-    Att,
     /// Manhattan distance rounded to the nearest integer (TSPLIB `MAN_2D`, `MAN_3D`).
     ManhattanNint,
     /// Manhattan distance, unrounded.
     Manhattan,
     /// Chebyshev (maximum) distance rounded to the nearest integer (TSPLIB `MAX_2D`, `MAX_3D`).
     MaximumNint,
-    /// TSPLIB geographical distance; coordinates are `DDD.MM` latitude/longitude.
-    Geo,
 }
 
 /// Costs computed on demand from point coordinates, so no n² matrix is ever stored.
 #[derive(Clone, Debug)]
-pub struct PointCost {
+pub struct PointCost<M: PointMetric = Metric> {
     points: Vec<[f64; 3]>,
-    metric: Metric,
-    /// Precomputed radians for [`Metric::Geo`].
-    geo: Vec<[f64; 2]>,
+    metric: M,
     /// A bound on every cost (see [`CostModel::cost_bound`]).
     bound: Cost,
 }
 
-impl PointCost {
+impl<M: PointMetric> PointCost<M> {
     /// Builds the model. For 2D data leave the third coordinate 0.
-    pub fn new(points: Vec<[f64; 3]>, metric: Metric) -> Self {
-        let geo = if metric == Metric::Geo {
-            points.iter().map(|p| [geo_radians(p[0]), geo_radians(p[1])]).collect()
-        } else {
-            Vec::new()
-        };
+    pub fn new(points: Vec<[f64; 3]>, metric: M) -> Self {
         let bound = metric.bound(extents(&points));
-        PointCost { points, metric, geo, bound }
+        PointCost { points, metric, bound }
     }
 
     /// The two states whose coordinates differ most along one axis (the first such pair by
@@ -242,9 +255,8 @@ impl PointCost {
         if self.points.len() < 2 {
             return None;
         }
-        let axes = if self.metric == Metric::Att { 2 } else { 3 };
         let mut best: Option<(f64, usize, usize)> = None;
-        for k in 0..axes {
+        for k in 0..3 {
             let (mut lo, mut hi) = (0, 0);
             for (i, p) in self.points.iter().enumerate() {
                 if p[k] < self.points[lo][k] {
@@ -263,7 +275,7 @@ impl PointCost {
         Some((StateId(a as u32), StateId(b as u32)))
     }
 
-    /// True when every cost is an integer (the TSPLIB roundings and GEO).
+    /// True when every cost is an integer (the rounded metrics).
     pub fn is_integral(&self) -> bool {
         self.metric.is_integral()
     }
@@ -274,36 +286,44 @@ impl PointCost {
     }
 
     /// The metric.
-    pub fn metric(&self) -> Metric {
+    pub fn metric(&self) -> M {
         self.metric
     }
 }
 
-impl Metric {
-    /// True when the metric's costs are integers.
-    pub fn is_integral(self) -> bool {
+impl PointMetric for Metric {
+    #[inline(always)]
+    fn cost(self, points: &[[f64; 3]], from: usize, to: usize) -> Cost {
+        let (a, b) = (&points[from], &points[to]);
+        let (dx, dy, dz) = (a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+        match self {
+            Metric::Euclidean => (dx * dx + dy * dy + dz * dz).sqrt(),
+            Metric::EuclideanNint => nint((dx * dx + dy * dy + dz * dz).sqrt()),
+            Metric::EuclideanCeil => ceil_nonneg((dx * dx + dy * dy + dz * dz).sqrt()),
+            Metric::Manhattan => dx.abs() + dy.abs() + dz.abs(),
+            Metric::ManhattanNint => nint(dx.abs() + dy.abs() + dz.abs()),
+            Metric::MaximumNint => nint(dx.abs().max(dy.abs()).max(dz.abs())),
+        }
+    }
+
+    fn is_integral(self) -> bool {
         !matches!(self, Metric::Euclidean | Metric::Manhattan)
     }
 
-    /// A bound on the cost between any two points whose coordinates differ by at most
-    /// `extent` along each axis (infinite if an extent is).
     fn bound(self, extent: [f64; 3]) -> Cost {
         let [x, y, z] = extent;
         match self {
             Metric::Euclidean => norm(x, y, z),
             Metric::EuclideanNint | Metric::EuclideanCeil => norm(x, y, z) + 1.0,
-            Metric::Att => norm(x, y, 0.0) / 10f64.sqrt() + 1.0,
             Metric::Manhattan => x + y + z,
             Metric::ManhattanNint => x + y + z + 1.0,
             Metric::MaximumNint => x.max(y).max(z) + 1.0,
-            // half the earth's circumference (TSPLIB's radius, acos ≤ π) plus the rounding
-            Metric::Geo => 6378.388 * std::f64::consts::PI + 1.0,
         }
     }
 }
 
 /// The Euclidean norm of a vector without overflow in the squares.
-fn norm(x: f64, y: f64, z: f64) -> f64 {
+pub fn norm(x: f64, y: f64, z: f64) -> f64 {
     let m = x.abs().max(y.abs()).max(z.abs());
     if m == 0.0 || !m.is_finite() {
         return m;
@@ -328,10 +348,10 @@ fn extents(points: &[[f64; 3]]) -> [f64; 3] {
     out
 }
 
-/// Smallest integer not below `x` (x ≥ 0), without a libm call. For TSPLIB's `ATT` this equals
-/// its "nint, plus one if below" rule. Exact for every `x`: from 2⁵² on `x` is an integer.
+/// Smallest integer not below `x` (x ≥ 0), without a libm call. Exact for every `x`: from 2⁵²
+/// on `x` is an integer.
 #[inline]
-fn ceil_pos(x: f64) -> f64 {
+pub fn ceil_nonneg(x: f64) -> f64 {
     if x >= INTEGRAL_FROM || x.is_nan() {
         return x;
     }
@@ -343,66 +363,26 @@ fn ceil_pos(x: f64) -> f64 {
     }
 }
 
-impl PointCost {
-    /// TSPLIB's geographical distance (kept out of line: it is rare and large).
-    #[cold]
-    #[inline(never)]
-    fn geo_cost(&self, from: StateId, to: StateId) -> Cost {
-        if from == to {
-            return 0.0;
-        }
-        const RRR: f64 = 6378.388;
-        let [lat1, lon1] = self.geo[from.index()];
-        let [lat2, lon2] = self.geo[to.index()];
-        let q1 = (lon1 - lon2).cos();
-        let q2 = (lat1 - lat2).cos();
-        let q3 = (lat1 + lat2).cos();
-        (RRR * (0.5 * ((1.0 + q1) * q2 - (1.0 - q1) * q3)).acos() + 1.0).floor()
-    }
-}
-
-/// TSPLIB's conversion of `DDD.MM` to radians (with its value of π).
-fn geo_radians(x: f64) -> f64 {
-    // TSPLIB's reference code uses this truncated value; distances must match it exactly.
-    #[allow(clippy::approx_constant)]
-    const PI: f64 = 3.141592;
-    let deg = x.trunc();
-    let min = x - deg;
-    PI * (deg + 5.0 * min / 3.0) / 180.0
-}
-
 /// TSPLIB's `nint`: round half up, as `(int)(x + 0.5)` in the reference code (x ≥ 0 here, so
 /// truncation is the floor; the cast avoids a libm call on baseline x86-64). Exact for every
 /// `x`, where the reference code's `int` would overflow: from 2⁵² on `x` is an integer (and
 /// the cast would saturate at 2⁶³).
 #[inline]
-fn nint(x: f64) -> f64 {
+pub fn nint(x: f64) -> f64 {
     if x >= INTEGRAL_FROM || x.is_nan() {
         return x;
     }
     (x + 0.5) as i64 as f64
 }
 
-impl CostModel for PointCost {
+impl<M: PointMetric> CostModel for PointCost<M> {
     fn num_states(&self) -> usize {
         self.points.len()
     }
 
     #[inline(always)]
     fn cost(&self, from: StateId, to: StateId) -> Cost {
-        let a = &self.points[from.index()];
-        let b = &self.points[to.index()];
-        let (dx, dy, dz) = (a[0] - b[0], a[1] - b[1], a[2] - b[2]);
-        match self.metric {
-            Metric::Euclidean => (dx * dx + dy * dy + dz * dz).sqrt(),
-            Metric::EuclideanNint => nint((dx * dx + dy * dy + dz * dz).sqrt()),
-            Metric::EuclideanCeil => ceil_pos((dx * dx + dy * dy + dz * dz).sqrt()),
-            Metric::Att => ceil_pos(((dx * dx + dy * dy) / 10.0).sqrt()),
-            Metric::Manhattan => dx.abs() + dy.abs() + dz.abs(),
-            Metric::ManhattanNint => nint(dx.abs() + dy.abs() + dz.abs()),
-            Metric::MaximumNint => nint(dx.abs().max(dy.abs()).max(dz.abs())),
-            Metric::Geo => self.geo_cost(from, to),
-        }
+        self.metric.cost(&self.points, from.index(), to.index())
     }
 
     fn is_symmetric(&self) -> bool {
@@ -414,12 +394,9 @@ impl CostModel for PointCost {
     }
 
     fn position(&self, state: StateId) -> Option<[f64; 3]> {
-        match self.metric {
-            // GEO coordinates are angles: a k-d tree on them would mislead near the poles and
-            // the date line, so neighbour lists come from the costs instead.
-            Metric::Geo => None,
-            _ => Some(self.points[state.index()]),
-        }
+        // Angles (latitude and longitude) would mislead a spatial tree near the poles and the
+        // date line, so their neighbour lists come from the costs instead.
+        self.metric.is_spatial().then(|| self.points[state.index()])
     }
 }
 
@@ -434,9 +411,6 @@ mod tests {
         assert_eq!(p.cost(StateId(0), StateId(1)), 5.0);
         let p = PointCost::new(vec![[0.0, 0.0, 0.0], [3.0, 4.5, 0.0]], Metric::EuclideanCeil);
         assert_eq!(p.cost(StateId(0), StateId(1)), 6.0);
-        // ATT: sqrt((100 + 0)/10) = 3.162 -> nint 3 < r -> 4
-        let p = PointCost::new(vec![[0.0, 0.0, 0.0], [10.0, 0.0, 0.0]], Metric::Att);
-        assert_eq!(p.cost(StateId(0), StateId(1)), 4.0);
     }
 
     proptest::proptest! {
@@ -448,7 +422,7 @@ mod tests {
             // round half up: the floor, plus one if the fraction (exact in floating point) is ≥ ½
             let half_up = x.floor() + if x - x.floor() >= 0.5 { 1.0 } else { 0.0 };
             proptest::prop_assert_eq!(nint(x), half_up);
-            proptest::prop_assert_eq!(ceil_pos(x), x.ceil());
+            proptest::prop_assert_eq!(ceil_nonneg(x), x.ceil());
         }
     }
 
@@ -479,18 +453,15 @@ mod tests {
             ((x >> 11) as f64 / (1u64 << 53) as f64 - 0.3) * 2000.0
         };
         let pts: Vec<[f64; 3]> = (0..40).map(|_| [next(), next(), next()]).collect();
-        let geo: Vec<[f64; 3]> = pts.iter().map(|p| [p[0] / 20.0, p[1] / 10.0, 0.0]).collect();
         for metric in [
             Metric::Euclidean,
             Metric::EuclideanNint,
             Metric::EuclideanCeil,
-            Metric::Att,
             Metric::Manhattan,
             Metric::ManhattanNint,
             Metric::MaximumNint,
-            Metric::Geo,
         ] {
-            let p = PointCost::new(if metric == Metric::Geo { geo.clone() } else { pts.clone() }, metric);
+            let p = PointCost::new(pts.clone(), metric);
             let bound = p.cost_bound().unwrap();
             let max = (0..40u32)
                 .flat_map(|i| (0..40u32).map(move |j| (i, j)))
