@@ -243,11 +243,63 @@ pub fn optimize(
     cancelled()?;
     stage(Stage::Solving { initial_cost: check(&afp.problem, &afp.original).ok() });
     let t2 = Instant::now();
+    let (solver, steps) = solve_order(&program, &afp, opts)?;
+    let t_solve = t2.elapsed().as_secs_f64();
+    cancelled()?;
+    stage(Stage::Writing);
+    let t3 = Instant::now();
+    let planner = safety.map(|s| s.planner().as_ref());
+    let proposed = placements(&steps);
+    let proposed_text = rewrite_with(&program, &proposed, machine, dialect, &afp.reversed, planner)?;
+    let t_rewrite = t3.elapsed().as_secs_f64();
+    let t4 = Instant::now();
+    let chosen = Written::choose(
+        Written { order: proposed, text: proposed_text },
+        text,
+        &program,
+        &afp,
+        machine,
+        dialect,
+        opts,
+        input_safety.as_ref().filter(|before| !before.is_safe()).and(planner),
+    )?;
+    let safety = check_output_safety(&program, &chosen.parsed, machine, safety, input_safety)?;
+    let t_verify = t4.elapsed().as_secs_f64();
+    Ok(Optimized {
+        text: chosen.written.text,
+        program,
+        output: chosen.parsed,
+        afp,
+        order: chosen.written.order,
+        verification: chosen.verification,
+        solver,
+        timings: Timings {
+            parse: t_parse,
+            build: t_build,
+            solve: t_solve,
+            rewrite: t_rewrite,
+            verify: t_verify,
+            total: t0.elapsed().as_secs_f64(),
+        },
+        fell_back: chosen.fallback.is_some(),
+        fallback: chosen.fallback,
+        width,
+        safety,
+    })
+}
+
+/// Runs the chosen solver from the program's own order; with a cell, a failure to find safe
+/// transits is said as such. Returns the summary and the solver's steps.
+fn solve_order(
+    program: &Program,
+    afp: &AfpProblem,
+    opts: &OptimizeOptions,
+) -> Result<(SolverSummary, Vec<Step>), NcError> {
     let report = sequence(
         opts.solver,
         &opts.baselines,
-        &program,
-        &afp,
+        program,
+        afp,
         &opts.afp,
         &SolveOptions {
             time_limit: opts.time_limit,
@@ -260,7 +312,7 @@ pub fn optimize(
             ..SolveOptions::default()
         },
     )
-    .map_err(|e| match (safety, &e) {
+    .map_err(|e| match (opts.safety.as_ref(), &e) {
         (Some(sf), NcError::Sequencing(_) | NcError::Solver(_)) => NcError::Unsafe(format!(
             "no order of the courses found whose every transit can be made safe (a clearance of {} mm within the \
              travel limits): {e}",
@@ -268,113 +320,115 @@ pub fn optimize(
         )),
         _ => e,
     })?;
-    let t_solve = t2.elapsed().as_secs_f64();
-    cancelled()?;
-    stage(Stage::Writing);
-    let solver = SolverSummary {
+    let summary = SolverSummary {
         solver: opts.solver.to_string(),
         initial_cost: report.initial_cost.unwrap_or(f64::NAN),
         cost: report.solution.cost,
         iterations: report.iterations,
         exact: report.exact,
     };
-    let t3 = Instant::now();
-    let mut order = placements(&report.solution.steps);
-    let planner = safety.map(|s| s.planner().as_ref());
-    let mut out = rewrite_with(&program, &order, machine, dialect, &afp.reversed, planner)?;
-    let t_rewrite = t3.elapsed().as_secs_f64();
-    let t4 = Instant::now();
-    let vopts = VerifyOptions {
-        width: opts.afp.width_or(dialect),
-        strict_plies: opts.afp.precedence == crate::problem::PrecedenceRule::Plies,
-        keep_ply_order: opts.afp.keep_ply_order,
-        doherty_sets: opts.afp.precedence == crate::problem::PrecedenceRule::Sets,
-    };
-    // The output parsed and verified; the parse is kept for the safety checks below.
-    let check = |text: &str| -> Result<(Verification, Program), NcError> {
-        let parsed = crate::parse::parse(text, machine, dialect).map_err(|e| NcError::SelfCheck(e.to_string()))?;
-        let v = verify_parsed(&program, &parsed, machine, dialect, &vopts, afp.footprints.as_ref())
-            .map_err(|e| NcError::SelfCheck(e.to_string()))?;
-        Ok((v, parsed))
-    };
-    let (mut verification, mut parsed) = check(&out)?;
-    let identity: Vec<Placement> =
-        (0..program.courses.len()).map(|c| Placement { course: c, reversed: false }).collect();
-    let mut fallback = fallback_reason(&verification, opts.afp.cost);
-    match (&input_safety, planner) {
-        (Some(before), Some(planner)) if !before.is_safe() => {
-            // The input itself is unsafe, so it is no fallback: the solver's order is compared
-            // with the input order written with safe transits, and the better one is kept.
-            let safe_input = rewrite_with(&program, &identity, machine, dialect, &afp.reversed, Some(planner))?;
-            let (v, p) = check(&safe_input)?;
-            fallback = worse_than(&verification, &v, opts.afp.cost);
-            if fallback.is_some() {
-                order = identity;
-                out = safe_input;
-                (verification, parsed) = (v, p);
-            }
-        }
-        _ if fallback.is_some() => {
-            order = identity;
-            out = text.to_string();
-            (verification, parsed) = check(&out)?;
-        }
-        _ => {}
-    }
-    let safety = match (safety, input_safety) {
-        (Some(sf), Some(before)) => {
-            let after = check_program(&parsed, sf);
-            if !after.is_safe() {
-                let mut why = vec![format!("the program towpath would write has {}", after.summary())];
-                if !before.is_safe() {
-                    why.push(format!("the input has {}", before.summary()));
+    Ok((summary, report.solution.steps))
+}
+
+/// A program text and the order of courses it was written in.
+struct Written {
+    order: Vec<Placement>,
+    text: String,
+}
+
+/// The program optimize hands back, verified against the input, with its parse.
+struct Chosen {
+    written: Written,
+    verification: Verification,
+    parsed: Program,
+    /// Why the input order was kept instead of the solver's, if it was.
+    fallback: Option<Fallback>,
+}
+
+impl Written {
+    /// Verifies the solver's program against the input and keeps it unless it is worse under
+    /// the chosen cost, in which case the input order is kept: the input itself, or, when the
+    /// input is unsafe in the cell (`unsafe_input_planner` given), the input order re-written
+    /// with safe transits (then that is no fallback but the better of two safe programs).
+    #[allow(clippy::too_many_arguments)]
+    fn choose(
+        proposed: Written,
+        input: &str,
+        program: &Program,
+        afp: &AfpProblem,
+        machine: &Machine,
+        dialect: &Dialect,
+        opts: &OptimizeOptions,
+        unsafe_input_planner: Option<&towpath_motion::Planner>,
+    ) -> Result<Chosen, NcError> {
+        let vopts = VerifyOptions {
+            width: opts.afp.width_or(dialect),
+            strict_plies: opts.afp.precedence == crate::problem::PrecedenceRule::Plies,
+            keep_ply_order: opts.afp.keep_ply_order,
+            doherty_sets: opts.afp.precedence == crate::problem::PrecedenceRule::Sets,
+        };
+        // A program parsed and verified; the parse is kept for the safety checks.
+        let check = |written: Written| -> Result<Chosen, NcError> {
+            let parsed =
+                crate::parse::parse(&written.text, machine, dialect).map_err(|e| NcError::SelfCheck(e.to_string()))?;
+            let verification = verify_parsed(program, &parsed, machine, dialect, &vopts, afp.footprints.as_ref())
+                .map_err(|e| NcError::SelfCheck(e.to_string()))?;
+            Ok(Chosen { written, verification, parsed, fallback: None })
+        };
+        let identity: Vec<Placement> =
+            (0..program.courses.len()).map(|c| Placement { course: c, reversed: false }).collect();
+        let mut chosen = check(proposed)?;
+        match unsafe_input_planner {
+            Some(planner) => {
+                let text = rewrite_with(program, &identity, machine, dialect, &afp.reversed, Some(planner))?;
+                let safe_input = check(Written { order: identity, text })?;
+                if let Some(why) = worse_than(&chosen.verification, &safe_input.verification, opts.afp.cost) {
+                    chosen = Chosen { fallback: Some(why), ..safe_input };
                 }
-                why.extend(after.details(5));
-                return Err(NcError::Unsafe(why.join("\n")));
             }
-            Some(SafetyPair { before, after })
-        }
-        _ => {
-            // Without a cell, the travel limits are still checked on what is written.
-            let outside = limit_violations(&parsed, machine);
-            if !outside.is_empty() {
-                let input = limit_violations(&program, machine).len();
-                let report = SafetyReport { limit_violations: outside, ..SafetyReport::default() };
-                return Err(NcError::Unsafe(format!(
-                    "the program towpath would write leaves the travel limits ({}):\n{}",
-                    if input > 0 {
-                        format!("the input does too, on {input} lines")
-                    } else {
-                        "the input does not".into()
-                    },
-                    report.details(5).join("\n")
-                )));
+            None => {
+                if let Some(why) = fallback_reason(&chosen.verification, opts.afp.cost) {
+                    let kept = check(Written { order: identity, text: input.to_string() })?;
+                    chosen = Chosen { fallback: Some(why), ..kept };
+                }
             }
-            None
         }
-    };
-    let t_verify = t4.elapsed().as_secs_f64();
-    Ok(Optimized {
-        text: out,
-        program,
-        output: parsed,
-        afp,
-        order,
-        verification,
-        solver,
-        timings: Timings {
-            parse: t_parse,
-            build: t_build,
-            solve: t_solve,
-            rewrite: t_rewrite,
-            verify: t_verify,
-            total: t0.elapsed().as_secs_f64(),
-        },
-        fell_back: fallback.is_some(),
-        fallback,
-        width,
-        safety,
-    })
+        Ok(chosen)
+    }
+}
+
+/// The motion-safety checks of what optimize writes: with a cell, no collision and no axis
+/// outside its limits (the input's state said beside); without one, the travel limits alone.
+fn check_output_safety(
+    program: &Program,
+    output: &Program,
+    machine: &Machine,
+    safety: Option<&Safety>,
+    input_safety: Option<SafetyReport>,
+) -> Result<Option<SafetyPair>, NcError> {
+    if let (Some(sf), Some(before)) = (safety, input_safety) {
+        let after = check_program(output, sf);
+        if !after.is_safe() {
+            let mut why = vec![format!("the program towpath would write has {}", after.summary())];
+            if !before.is_safe() {
+                why.push(format!("the input has {}", before.summary()));
+            }
+            why.extend(after.details(5));
+            return Err(NcError::Unsafe(why.join("\n")));
+        }
+        return Ok(Some(SafetyPair { before, after }));
+    }
+    let outside = limit_violations(output, machine);
+    if outside.is_empty() {
+        return Ok(None);
+    }
+    let input = limit_violations(program, machine).len();
+    let report = SafetyReport { limit_violations: outside, ..SafetyReport::default() };
+    Err(NcError::Unsafe(format!(
+        "the program towpath would write leaves the travel limits ({}):\n{}",
+        if input > 0 { format!("the input does too, on {input} lines") } else { "the input does not".into() },
+        report.details(5).join("\n")
+    )))
 }
 
 /// Why the solver's order is not returned, if it is not: measured on the rewritten program by
