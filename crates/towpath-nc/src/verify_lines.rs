@@ -480,10 +480,31 @@ pub(crate) fn account(
     machine: &Machine,
 ) -> Result<(), VerifyError> {
     let Some(reader) = Reader::new(dialect, machine) else { return Ok(()) };
-    let len = opt.lines.len();
     let footer_len = orig.lines.len() - orig.footer_start;
-    let footer_start = len - footer_len;
+    let footer_start = opt.lines.len() - footer_len;
+    let blocks = course_blocks(orig, opt, order, windows, dialect, machine, footer_start)?;
+    let missing_marker = between_courses(orig, opt, order, &blocks, &reader, footer_start)?;
+    same_switches(orig, opt, order, &blocks, &reader, footer_start)?;
+    match missing_marker {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// Each optimized course's block of lines (in the optimized program's order): the original's
+/// lines as they were, or a reversal's lines as the rules of a reversal write them; blocks in
+/// order, none inside the header, the footer or another.
+fn course_blocks(
+    orig: &Program,
+    opt: &Program,
+    order: &[Placement],
+    windows: &[Option<Range<usize>>],
+    dialect: &Dialect,
+    machine: &Machine,
+    footer_start: usize,
+) -> Result<Vec<Range<usize>>, VerifyError> {
     // The courses' blocks, in the optimized program's order.
+    let len = opt.lines.len();
     let mut blocks: Vec<Range<usize>> = Vec::with_capacity(order.len());
     for (kc, p) in order.iter().enumerate() {
         let name = || orig.course_name(p.course);
@@ -542,6 +563,21 @@ pub(crate) fn account(
         }
         blocks.push(block);
     }
+    Ok(blocks)
+}
+
+/// The lines between the course blocks: each one travels with a course (once), is a ply
+/// comment, a transit, one of the original's on-part lines the rewriter may repeat, or it is
+/// extra. Every line that must travel is found. A ply comment that is missing is returned (not
+/// failed on), so that the switch check speaks first.
+fn between_courses(
+    orig: &Program,
+    opt: &Program,
+    order: &[Placement],
+    blocks: &[Range<usize>],
+    reader: &Reader,
+    footer_start: usize,
+) -> Result<Option<VerifyError>, VerifyError> {
     // Ply comments of plies with courses may move and repeat; every one must be there (those
     // between courses: one inside a span, where a long retract block reaches, stays with it).
     let between = |j: usize| {
@@ -626,8 +662,22 @@ pub(crate) fn account(
     if let Some((j, alts)) = need.iter().zip(&used).filter(|(_, u)| !**u).map(|(n, _)| n).min_by_key(|n| n.0) {
         return Err(VerifyError::LostLine { line: j + 1, text: alts.last().copied().unwrap_or("").to_string() });
     }
-    // Each course runs with the switches on that it ran with in the original, and so does the
-    // footer.
+    Ok(markers_seen
+        .iter()
+        .position(|s| !s)
+        .map(|m| VerifyError::LostLine { line: marker_lines[m] + 1, text: marker_texts[m].to_string() }))
+}
+
+/// Each course runs with the switches on that it ran with in the original (a reversed one
+/// switches nothing that is on where it starts), and so does the footer.
+fn same_switches(
+    orig: &Program,
+    opt: &Program,
+    order: &[Placement],
+    blocks: &[Range<usize>],
+    reader: &Reader,
+    footer_start: usize,
+) -> Result<(), VerifyError> {
     let states = |p: &Program| {
         let mut on: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
         let mut before = Vec::with_capacity(p.lines.len() + 1);
@@ -680,9 +730,6 @@ pub(crate) fn account(
                 b[footer_start], a[orig.footer_start]
             )));
         }
-    }
-    if let Some(m) = markers_seen.iter().position(|s| !s) {
-        return Err(VerifyError::LostLine { line: marker_lines[m] + 1, text: marker_texts[m].to_string() });
     }
     Ok(())
 }
