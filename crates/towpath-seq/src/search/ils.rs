@@ -23,6 +23,9 @@ const KICK_SEGMENT: usize = 50;
 /// tours of thousands of nodes (measured against 50, 100 and 500 on TSPLIB; see the history).
 const BRIDGE_SEGMENT: usize = 200;
 
+/// Kicks without a new best, per node, after which a restless [`Chain`] restarts.
+const RESTLESS_AFTER: u64 = 1;
+
 /// Ruin-and-recreate kicks are used on instances up to this size (they cost O(n) each).
 const REBUILD_UP_TO: usize = 5000;
 
@@ -38,18 +41,31 @@ pub(crate) struct Chain {
     pub best: Tour,
     pub rng: Pcg64Mcg,
     pub stagnation: u64,
+    /// Restarts from a perturbed best after [`RESTLESS_AFTER`] × n kicks without a new best
+    /// (instead of 16 × n): a chain that leaves its basin often, which pays on clustered
+    /// geometry (whole clusters in the wrong order), where the other chains keep deepening.
+    pub restless: bool,
 }
 
 impl Chain {
     pub fn new(start: &Tour, seed: u64) -> Self {
-        Chain { cur: start.clone(), best: start.clone(), rng: Pcg64Mcg::seed_from_u64(seed), stagnation: 0 }
+        Chain {
+            cur: start.clone(),
+            best: start.clone(),
+            rng: Pcg64Mcg::seed_from_u64(seed),
+            stagnation: 0,
+            restless: false,
+        }
     }
 
     /// Adopts `tour` as both current and best.
     pub fn adopt(&mut self, tour: &Tour) {
         self.cur.clone_from(tour);
         self.best.clone_from(tour);
-        self.stagnation = 0;
+        // a restless chain keeps counting: its next restart perturbs the adopted tour
+        if !self.restless {
+            self.stagnation = 0;
+        }
     }
 }
 
@@ -78,6 +94,9 @@ pub(crate) struct Ils<'a, 'p, C> {
     rebuild: bool,
     /// Kick with a four-arc double bridge (the local search has sequential 3-opt steps).
     bridge4: bool,
+    /// Kicks without a new best after which the chain restarts from a heavily perturbed copy
+    /// of its best tour.
+    restart_after: u64,
 }
 
 impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
@@ -86,7 +105,8 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         let dp_each_kick = net.multi_mode && net.n * mm * mm <= 20_000;
         let rebuild = net.n <= REBUILD_UP_TO && (net.has_prec || net.has_groups || net.multi_mode);
         let bridge4 = super::local::uses_or3(net);
-        Ils { net, nb, eps, dp_each_kick, rebuild, bridge4 }
+        let restart_after = 16 * net.n as u64 + 200;
+        Ils { net, nb, eps, dp_each_kick, rebuild, bridge4, restart_after }
     }
 
     /// Brings a tour to a local optimum of the moves and the mode DP.
@@ -121,7 +141,8 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
 
     /// Runs kicks on a chain's state and returns the kicks done.
     pub fn run(&self, state: &mut Chain, budget: Budget, cancel: Option<&AtomicBool>) -> u64 {
-        let Chain { cur, best, rng, stagnation } = state;
+        let Chain { cur, best, rng, stagnation, restless } = state;
+        let restart_after = if *restless { RESTLESS_AFTER * cur.len() as u64 + 200 } else { self.restart_after };
         let mut ls = LocalSearch::new(self.net, self.nb, self.eps);
         ls.deadline = budget.hard;
         let n = cur.len();
@@ -139,7 +160,7 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
                 break;
             }
             kicks += 1;
-            if *stagnation >= 16 * n as u64 + 200 {
+            if *stagnation >= restart_after {
                 // Long stagnation: restart from a heavily perturbed copy of the best tour.
                 *stagnation = 0;
                 cur.clone_from(best);

@@ -320,8 +320,14 @@ fn search_epochs<C: CostModel>(
         d - reserve
     });
     let merge_chains = threads > 1 && local::uses_or3(net);
-    let mut chains: Vec<ils::Chain> =
-        (0..threads).map(|t| ils::Chain::new(best, opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ t as u64)).collect();
+    let mut chains: Vec<ils::Chain> = (0..threads)
+        .map(|t| {
+            let mut chain = ils::Chain::new(best, opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ t as u64);
+            // a portfolio on plain tours: every second chain restarts often (clustered geometry)
+            chain.restless = t % 2 == 1 && local::uses_or3(net);
+            chain
+        })
+        .collect();
     while iterations < total_kicks {
         if search_end.is_some_and(|d| Instant::now() >= d) || clock.cancelled() {
             break;
