@@ -94,6 +94,9 @@ pub(crate) struct Ils<'a, 'p, C> {
     rebuild: bool,
     /// Kick with a four-arc double bridge (the local search has sequential 3-opt steps).
     bridge4: bool,
+    /// Kick with the precedence-keeping double bridge (the local search has the whole
+    /// SOP-3-exchange neighbourhood, which undoes any segment swap that does not pay).
+    sop3_bridge: bool,
     /// Kicks without a new best after which the chain restarts from a heavily perturbed copy
     /// of its best tour.
     restart_after: u64,
@@ -105,8 +108,9 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         let dp_each_kick = net.multi_mode && net.n * mm * mm <= 20_000;
         let rebuild = net.n <= REBUILD_UP_TO && (net.has_prec || net.has_groups || net.multi_mode);
         let bridge4 = super::local::uses_or3(net);
+        let sop3_bridge = super::sop3::applies(net);
         let restart_after = 16 * net.n as u64 + 200;
-        Ils { net, nb, eps, dp_each_kick, rebuild, bridge4, restart_after }
+        Ils { net, nb, eps, dp_each_kick, rebuild, bridge4, sop3_bridge, restart_after }
     }
 
     /// Brings a tour to a local optimum of the moves and the mode DP.
@@ -250,6 +254,14 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         let n = tour.len();
         if self.bridge4 && n >= 8 {
             return self.double_bridge(tour, rng, ls);
+        }
+        if self.sop3_bridge {
+            if let Some(ends) = super::sop3::bridge(net, tour, rng) {
+                for x in ends {
+                    ls.push(x);
+                }
+                return true;
+            }
         }
         let max_len = (n / 2).clamp(1, KICK_SEGMENT);
         for _attempt in 0..20 {

@@ -11,6 +11,7 @@ use std::time::Instant;
 
 use super::neighbors::Neighbors;
 use super::net::{Net, NO_REV};
+use super::sop3::{self, Sop3};
 use super::tour::Tour;
 use crate::cost::{Cost, CostModel};
 
@@ -98,6 +99,8 @@ pub(crate) struct LocalSearch<'a, 'p, C> {
     /// Arcs the current chain of 3-opt moves added and removed.
     lk3_added: Vec<(u32, u32)>,
     lk3_removed: Vec<(u32, u32)>,
+    /// The exhaustive SOP-3-exchange, where it applies (see `sop3::applies`).
+    sop3: Option<Sop3>,
 }
 
 /// Whether Or-opt and the segment exchange apply the positive-gain criterion: a move whose
@@ -157,6 +160,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             lk3: or3,
             lk3_added: Vec::new(),
             lk3_removed: Vec::new(),
+            sop3: sop3::applies(net).then(|| Sop3::new(net.n)),
         }
     }
 
@@ -245,10 +249,18 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             // (from the candidates); skipping them leaves time for more kicks.
             return false;
         }
-        if self.try_or_opt(tour, v) {
+        if self.try_or_opt(tour, v) || self.try_swap(tour, v) {
             return true;
         }
-        self.try_swap(tour, v)
+        // the candidate-list moves first (cheap), then the whole 3-exchange neighbourhood
+        let found = self.sop3.as_mut().and_then(|s| s.find(self.net, tour, v, self.eps));
+        if let Some(ex) = found {
+            for x in sop3::apply(tour, ex) {
+                self.push(x);
+            }
+            return true;
+        }
+        false
     }
 
     /// Path-preserving 3-opt ("segment exchange", the SOP-3-exchange of Gambardella and Dorigo):

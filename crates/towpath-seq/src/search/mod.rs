@@ -9,6 +9,7 @@ mod merge;
 mod modes;
 mod neighbors;
 mod net;
+mod sop3;
 mod tour;
 
 /// Test problems shared by the search modules' tests.
