@@ -318,31 +318,12 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
     /// becomes A D C B, four arcs changed in two alternating cycles, which no sequential move
     /// undoes in one step. Plain symmetric one-mode tours only (no precedence, groups or modes).
     fn double_bridge(&self, tour: &mut Tour, rng: &mut Pcg64Mcg, ls: &mut LocalSearch<'_, '_, C>) -> bool {
-        let net = self.net;
         let n = tour.len();
         let max_len = ((n - 2) / 3).clamp(1, BRIDGE_SEGMENT);
         let (l1, l2, l3) = (rng.gen_range(1..=max_len), rng.gen_range(1..=max_len), rng.gen_range(1..=max_len));
         let i = rng.gen_range(1..=n - l1 - l2 - l3);
         let (j, k, l) = (i + l1 - 1, i + l1 + l2 - 1, i + l1 + l2 + l3 - 1);
-        let (p, a, b, c, d, e, f, q) = (
-            tour.seq[i - 1],
-            tour.seq[i],
-            tour.seq[j],
-            tour.seq[j + 1],
-            tour.seq[k],
-            tour.seq[k + 1],
-            tour.seq[l],
-            tour.next_of_pos(l),
-        );
-        let old = tour.arc(net, p, a) + tour.arc(net, b, c) + tour.arc(net, d, e) + tour.arc(net, f, q);
-        let new = tour.arc(net, p, e) + tour.arc(net, f, c) + tour.arc(net, d, a) + tour.arc(net, b, q);
-        // B C D reversed as a whole, then each piece turned back
-        tour.reverse(i, l);
-        tour.reverse(i, i + l3 - 1);
-        tour.reverse(i + l3, i + l3 + l2 - 1);
-        tour.reverse(i + l3 + l2, l);
-        tour.cost += new - old;
-        for x in [p, a, b, c, d, e, f, q] {
+        for x in tour.double_bridge(self.net, i, j, k, l) {
             ls.push(x);
         }
         true

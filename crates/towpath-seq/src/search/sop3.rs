@@ -185,23 +185,7 @@ pub(crate) fn bridge<C: CostModel>(net: &Net<'_, C>, tour: &mut Tour, rng: &mut 
         if blocked(i..=j, j + 1) || blocked(j + 1..=k, k + 1) {
             continue;
         }
-        let (p, b0, b1, c0, c1, d0, d1, e) = (
-            tour.seq[i - 1],
-            tour.seq[i],
-            tour.seq[j],
-            tour.seq[j + 1],
-            tour.seq[k],
-            tour.seq[k + 1],
-            tour.seq[l],
-            tour.next_of_pos(l),
-        );
-        let old = tour.arc(net, p, b0) + tour.arc(net, b1, c0) + tour.arc(net, c1, d0) + tour.arc(net, d1, e);
-        let new = tour.arc(net, p, d0) + tour.arc(net, d1, c0) + tour.arc(net, c1, b0) + tour.arc(net, b1, e);
-        // B C D -> D B C -> D C B
-        tour.swap_adjacent(i, k, l);
-        tour.swap_adjacent(i + ld, i + ld + lb - 1, l);
-        tour.cost += new - old;
-        return Some([p, b0, b1, c0, c1, d0, d1, e]);
+        return Some(tour.double_bridge(net, i, j, k, l));
     }
     None
 }

@@ -249,6 +249,33 @@ impl Tour {
         self.refresh_pos(i, k);
     }
 
+    /// The double bridge on the segments B = `i..=j`, C = `j+1..=k` and D = `k+1..=l` (`1 ≤ i`,
+    /// `l < n`): they come back as D C B, each the same way round, and the cost is updated.
+    /// Returns the eight nodes whose arcs changed (the segments' ends and their outer
+    /// neighbours), for the local search's queue.
+    pub fn double_bridge<C: CostModel>(&mut self, net: &Net<C>, i: usize, j: usize, k: usize, l: usize) -> [u32; 8] {
+        let (p, b0, b1, c0, c1, d0, d1, e) = (
+            self.seq[i - 1],
+            self.seq[i],
+            self.seq[j],
+            self.seq[j + 1],
+            self.seq[k],
+            self.seq[k + 1],
+            self.seq[l],
+            self.next_of_pos(l),
+        );
+        let old = self.arc(net, p, b0) + self.arc(net, b1, c0) + self.arc(net, c1, d0) + self.arc(net, d1, e);
+        let new = self.arc(net, p, d0) + self.arc(net, d1, c0) + self.arc(net, c1, b0) + self.arc(net, b1, e);
+        // B C D reversed as a whole, then each piece turned back
+        let (lc, ld) = (k - j, l - k);
+        self.reverse(i, l);
+        self.reverse(i, i + ld - 1);
+        self.reverse(i + ld, i + ld + lc - 1);
+        self.reverse(i + ld + lc, l);
+        self.cost += new - old;
+        [p, b0, b1, c0, c1, d0, d1, e]
+    }
+
     /// Switches every node at positions `i..=j` to its reverse mode (which must exist).
     pub fn reverse_modes<C: CostModel>(&mut self, net: &Net<C>, i: usize, j: usize) {
         if net.modes_self_reverse {
