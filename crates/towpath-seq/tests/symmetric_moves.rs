@@ -108,3 +108,35 @@ fn plain_symmetric_tours_match_the_exact_optimum() {
     }
     assert!(misses.len() * 100 <= total, "misses:\n{}", misses.join("\n"));
 }
+
+#[test]
+fn stalled_epochs_end_the_search_early_and_deterministically() {
+    let pts = points(40, 7);
+    let mut b = Problem::builder(PointCost::new(pts, Metric::Euclidean));
+    b.point_tasks(40);
+    let p = b.build().unwrap();
+    let opts = |stall: Option<u32>| SolveOptions {
+        time_limit: None,
+        iterations: Some(40_000),
+        threads: 2,
+        exact_up_to: 0,
+        stall_epochs: stall,
+        ..Default::default()
+    };
+    let full = solve(&p, &opts(None)).unwrap();
+    let early = solve(&p, &opts(Some(2))).unwrap();
+    let again = solve(&p, &opts(Some(2))).unwrap();
+    assert_eq!(full.iterations, 40_000);
+    // 40 cities settle long before 40,000 kicks: the stall stops the search after a few epochs
+    assert!(early.iterations < full.iterations / 2, "{} kicks", early.iterations);
+    assert_eq!(early.solution.steps, again.solution.steps);
+    let c = check(&p, &early.solution.steps).unwrap();
+    assert!((c - early.solution.cost).abs() < 1e-6);
+    // on 40 cities both find the same (optimal) tour length
+    assert!(
+        (early.solution.cost - full.solution.cost).abs() < 1e-6,
+        "{} vs {}",
+        early.solution.cost,
+        full.solution.cost
+    );
+}

@@ -209,6 +209,44 @@ struct Step {
     a: DVec3,
     /// 1000 · F · h² · Δt: the constant factor of the step's contribution.
     c: f64,
+    /// Index of the pose that starts the step's segment.
+    segment: u32,
+}
+
+/// The per-step deposition formula of the module docs, with the gun's constants.
+struct Cone {
+    kernel: crate::profile::Kernel,
+    r2max: f64,
+    h2: f64,
+    reach: f64,
+}
+
+impl Cone {
+    fn new(gun: &Gun) -> Cone {
+        let kernel = gun.profile.kernel(gun.radius);
+        Cone { r2max: kernel.radius2(), kernel, h2: gun.standoff * gun.standoff, reach: REACH * gun.standoff }
+    }
+
+    /// Thickness (µm) one step leaves at point `p` with unit normal `n`.
+    #[inline]
+    fn amount(&self, st: &Step, p: DVec3, n: DVec3) -> f64 {
+        let v = p - st.g;
+        let z = v.dot(st.a);
+        if !(z > 0.0 && z <= self.reach) {
+            return 0.0;
+        }
+        let inv_z = 1.0 / z;
+        let rho2 = v.length_squared() - z * z;
+        let r2 = rho2 * self.h2 * inv_z * inv_z;
+        if !(r2 < self.r2max) {
+            return 0.0;
+        }
+        let vn = -v.dot(n);
+        if !(vn > 0.0) {
+            return 0.0;
+        }
+        st.c * self.kernel.density(r2.max(0.0)) * vn * inv_z * inv_z * inv_z
+    }
 }
 
 /// Checks a path: finite positions, unit axes, time stamps that never decrease.
@@ -233,7 +271,7 @@ fn steps(gun: &Gun, poses: &[Pose]) -> Vec<Step> {
     let delta = gun.radius / STEPS_PER_RADIUS;
     let h = gun.standoff;
     let mut out = Vec::new();
-    for w in poses.windows(2) {
+    for (segment, w) in poses.windows(2).enumerate() {
         let (p0, p1) = (&w[0], &w[1]);
         let dt = p1.time - p0.time;
         if !p0.spray || !(dt > 0.0) {
@@ -247,7 +285,7 @@ fn steps(gun: &Gun, poses: &[Pose]) -> Vec<Step> {
             let s = (k as f64 + 0.5) / m as f64;
             let g = p0.position.lerp(p1.position, s);
             let a = p0.axis.lerp(p1.axis, s).try_normalize().unwrap_or(p0.axis);
-            out.push(Step { g, a, c });
+            out.push(Step { g, a, c, segment: segment as u32 });
         }
     }
     out
@@ -305,9 +343,7 @@ pub fn simulate(gun: &Gun, poses: &[Pose], points: &SamplePoints) -> Result<Vec<
         bounds.push((i, j));
         i = j;
     }
-    let k = gun.profile.kernel(gun.radius);
-    let r2max = k.radius2();
-    let h2 = h * h;
+    let reach_of = Cone::new(gun);
     let results: Vec<(u32, Vec<f64>)> = bounds
         .par_iter()
         .map(|&(i, j)| {
@@ -317,23 +353,8 @@ pub fn simulate(gun: &Gun, poses: &[Pose], points: &SamplePoints) -> Result<Vec<
             for &(_, si) in &pairs[i..j] {
                 let st = steps[si as usize];
                 for (slot, &pi) in pts.iter().enumerate() {
-                    let p = points.positions[pi as usize];
-                    let v = p - st.g;
-                    let z = v.dot(st.a);
-                    if !(z > 0.0 && z <= reach) {
-                        continue;
-                    }
-                    let inv_z = 1.0 / z;
-                    let rho2 = v.length_squared() - z * z;
-                    let r2 = rho2 * h2 * inv_z * inv_z;
-                    if !(r2 < r2max) {
-                        continue;
-                    }
-                    let vn = -v.dot(points.normals[pi as usize]);
-                    if !(vn > 0.0) {
-                        continue;
-                    }
-                    vals[slot] += st.c * k.density(r2.max(0.0)) * vn * inv_z * inv_z * inv_z;
+                    let pi = pi as usize;
+                    vals[slot] += reach_of.amount(&st, points.positions[pi], points.normals[pi]);
                 }
             }
             (cell, vals)
@@ -346,6 +367,77 @@ pub fn simulate(gun: &Gun, poses: &[Pose], points: &SamplePoints) -> Result<Vec<
         }
     }
     Ok(out)
+}
+
+/// What each spray segment of a path leaves at the sample points, as the path is timed. The
+/// thickness of the path is the sum of the columns, and a segment sprayed for s times as long
+/// leaves s times its column: the model is linear in the segments' durations.
+#[derive(Debug, Clone, Default)]
+pub struct Influence {
+    /// The pose index that starts each segment (its spray runs to the next pose).
+    pub segments: Vec<u32>,
+    /// Per segment: (sample point, thickness in µm), points in increasing order.
+    pub columns: Vec<Vec<(u32, f64)>>,
+}
+
+/// The [`Influence`] of every spray segment of `poses` on `points`.
+pub fn influence(gun: &Gun, poses: &[Pose], points: &SamplePoints) -> Result<Influence, SprayError> {
+    gun.validate()?;
+    validate_path(poses)?;
+    let steps = steps(gun, poses);
+    if steps.len() > MAX_STEPS {
+        return Err(SprayError::TooLarge { what: format!("{} integration steps (at most {MAX_STEPS})", steps.len()) });
+    }
+    if points.is_empty() || steps.is_empty() {
+        return Ok(Influence::default());
+    }
+    // Steps come in segment order: cut them into runs of one segment.
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    let mut i = 0;
+    while i < steps.len() {
+        let mut j = i + 1;
+        while j < steps.len() && steps[j].segment == steps[i].segment {
+            j += 1;
+        }
+        runs.push((i, j));
+        i = j;
+    }
+    let grid = Grid::new(&points.positions, gun.radius);
+    let cone = Cone::new(gun);
+    let base = gun.radius * REACH;
+    let columns: Vec<Vec<(u32, f64)>> = runs
+        .par_iter()
+        .map(|&(i, j)| {
+            let mut col: Vec<(u32, f64)> = Vec::new();
+            for st in &steps[i..j] {
+                let c = st.g + st.a * cone.reach;
+                let ext = DVec3::new(
+                    base * (1.0 - st.a.x * st.a.x).max(0.0).sqrt(),
+                    base * (1.0 - st.a.y * st.a.y).max(0.0).sqrt(),
+                    base * (1.0 - st.a.z * st.a.z).max(0.0).sqrt(),
+                );
+                grid.for_cells(st.g.min(c - ext), st.g.max(c + ext), |cell| {
+                    for &pi in grid.points(cell) {
+                        let v = cone.amount(st, points.positions[pi as usize], points.normals[pi as usize]);
+                        if v > 0.0 {
+                            col.push((pi, v));
+                        }
+                    }
+                });
+            }
+            col.sort_unstable_by_key(|e| e.0);
+            col.dedup_by(|b, a| {
+                if a.0 == b.0 {
+                    a.1 += b.1;
+                    true
+                } else {
+                    false
+                }
+            });
+            col
+        })
+        .collect();
+    Ok(Influence { segments: runs.iter().map(|&(i, _)| steps[i].segment).collect(), columns })
 }
 
 /// A uniform grid of points (cells of about one footprint radius), for finding the points a

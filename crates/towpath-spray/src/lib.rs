@@ -14,8 +14,10 @@
 //!    GA / ant colony, `towpath-baselines`) orders them into one open path from an optional home,
 //!    [`transit`]s lifting where a straight move would come closer to the part than the standoff
 //!    allows, priced as they are written.
-//! 4. [`path`]: the poses with time stamps; [`thickness`]: the predicted thickness on the part
-//!    from any path; [`output`]: the path file, CSV, thickness PLY and summary.
+//! 4. [`path`]: the poses with time stamps; [`modulation`]: the speed along the passes adjusted
+//!    so the thickness is as even as the passes allow (seams included); [`thickness`]: the
+//!    predicted thickness on the part from any path; [`output`]: the path file, CSV, thickness
+//!    PLY and summary.
 //!
 //! [`plan()`] runs steps 1–4. Lengths are in mm, times in s, thickness in µm, flow in mm³/s.
 
@@ -26,6 +28,7 @@
 pub mod deposition;
 mod error;
 pub mod frame;
+pub mod modulation;
 pub mod output;
 pub mod partition;
 pub mod passes;

@@ -63,6 +63,7 @@ pub fn summary(plan: &SprayPlan, map: Option<&ThicknessMap>, meta: &Meta) -> Val
         "presplit_pieces": plan.partition.presplit_pieces,
         "topology_cells": plan.partition.cells,
         "timings": plan.timings,
+        "modulation": plan.modulation,
     });
     if let (Some(m), Some(o)) = (map, s.as_object_mut()) {
         o.insert("thickness".into(), thickness_json(m));

@@ -11,6 +11,7 @@ use towpath_geom::Mesh;
 use crate::deposition::{Gun, Pose};
 use crate::error::{positive, SprayError};
 use crate::frame::Frame;
+use crate::modulation::{modulate, ModulationReport, DEFAULT_MAX_SPEED_CHANGE};
 use crate::partition::{self, Partition, PartitionOptions};
 use crate::passes::{self, Pass, PassParams, PatchPlan, Pattern, PatternChoice, Planned};
 use crate::path::{assemble, PathTotals};
@@ -49,6 +50,9 @@ pub struct SprayParams {
     pub home: Option<DVec3>,
     /// Split pieces by topology before the flatness growth.
     pub topology: bool,
+    /// Largest factor by which [`modulation`](crate::modulation) may change the gun speed along
+    /// a pass (1: no modulation; ignored when `speed` is fixed).
+    pub max_speed_change: f64,
     /// Sequencing.
     pub seq: SeqOptions,
 }
@@ -67,6 +71,7 @@ impl SprayParams {
             travel_speed: DEFAULT_TRAVEL_SPEED,
             home: None,
             topology: true,
+            max_speed_change: DEFAULT_MAX_SPEED_CHANGE,
             seq: SeqOptions::default(),
         }
     }
@@ -101,6 +106,13 @@ impl SprayParams {
             }
         }
         positive("the travel speed", self.travel_speed)?;
+        if !(self.max_speed_change >= 1.0 && self.max_speed_change.is_finite()) {
+            return Err(SprayError::BadParameter {
+                what: "the largest speed change",
+                must: "a factor ≥ 1 (1: keep the planned speeds)",
+                got: self.max_speed_change,
+            });
+        }
         if let Some(h) = self.home {
             if !h.is_finite() {
                 return Err(SprayError::BadParameter { what: "the home position", must: "finite", got: f64::NAN });
@@ -119,6 +131,8 @@ pub struct Timings {
     pub passes_s: f64,
     /// Sequencing (including transits).
     pub sequence_s: f64,
+    /// Speed modulation.
+    pub modulation_s: f64,
 }
 
 /// A spray plan.
@@ -138,6 +152,8 @@ pub struct SprayPlan {
     pub totals: PathTotals,
     /// The profile's optimal spacing on an endless plane.
     pub optimum: SpacingChoice,
+    /// What the speed modulation did.
+    pub modulation: ModulationReport,
     /// Time per stage.
     pub timings: Timings,
 }
@@ -216,8 +232,14 @@ pub fn plan(mesh: &Mesh, params: &SprayParams) -> Result<SprayPlan, SprayError> 
     let t2 = Instant::now();
     let clearance = Clearance::new(mesh, gun.standoff);
     let sequenced = sequence(&passes, params.home, &clearance, &params.seq)?;
-    let (poses, totals) = assemble(&passes, &sequenced, params.home, params.travel_speed);
+    let (mut poses, mut totals) = assemble(&passes, &sequenced, params.home, params.travel_speed);
     let t_seq = t2.elapsed().as_secs_f64();
+    let t3 = Instant::now();
+    let change = if params.speed.is_some() { 1.0 } else { params.max_speed_change };
+    let modulation = modulate(mesh, &gun, &mut poses, params.target_thickness, change)?;
+    totals.spray_time_s += modulation.spray_time_after_s - modulation.spray_time_before_s;
+    totals.cycle_time_s = poses.last().map_or(0.0, |p| p.time);
+    let t_mod = t3.elapsed().as_secs_f64();
     Ok(SprayPlan {
         partition,
         patches,
@@ -226,7 +248,8 @@ pub fn plan(mesh: &Mesh, params: &SprayParams) -> Result<SprayPlan, SprayError> 
         poses,
         totals,
         optimum,
-        timings: Timings { partition_s: t_part, passes_s: t_passes, sequence_s: t_seq },
+        modulation,
+        timings: Timings { partition_s: t_part, passes_s: t_passes, sequence_s: t_seq, modulation_s: t_mod },
     })
 }
 

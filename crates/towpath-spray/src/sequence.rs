@@ -33,6 +33,8 @@ pub const MAX_ROUNDS: usize = 6;
 pub const KICKS_PER_PASS: u64 = 100;
 /// Smallest default work budget.
 pub const MIN_KICKS: u64 = 2000;
+/// The solver stops when this many of its twenty epochs in a row found nothing better.
+pub const STALL_EPOCHS: u32 = 3;
 /// Up to this many pairs of pass ends on different patches, every such transit is priced as
 /// written before the first solve (in parallel), so the solver sees the lifts from the start.
 pub const EAGER_PAIRS: usize = 20_000;
@@ -211,6 +213,7 @@ pub fn sequence(
         }
     }
     let mut initial: Option<Vec<Step>> = None;
+    let mut best: Option<(f64, Vec<Step>)> = None;
     let mut rounds = 0;
     let mut solver_seconds = 0.0;
     let steps = loop {
@@ -233,6 +236,7 @@ pub fn sequence(
             seed: opts.seed,
             threads: opts.threads.max(1),
             initial: initial.clone(),
+            stall_epochs: Some(STALL_EPOCHS),
             ..SolveOptions::default()
         };
         let report =
@@ -261,8 +265,15 @@ pub fn sequence(
             }
             transit_cache.insert(pr, t);
         }
+        // The route's length as written (every transit of it is now priced).
+        let written: f64 = pairs.iter().flatten().map(|pr| transit_cache.get(pr).map_or(0.0, |t| t.length)).sum();
+        if best.as_ref().is_none_or(|(c, _)| written < *c) {
+            best = Some((written, steps.clone()));
+        }
         if !added || rounds >= MAX_ROUNDS {
-            break steps;
+            // The last round may have found lifts it could not yet price: keep the route that is
+            // shortest as written.
+            break best.map_or(steps, |(_, s)| s);
         }
         initial = Some(steps);
     };

@@ -86,6 +86,10 @@ pub struct SolveOptions {
     /// Problems with at most this many tasks (and at most 6 modes per task) are solved exactly
     /// by dynamic programming instead (default 10).
     pub exact_up_to: usize,
+    /// Stop when this many epochs in a row (a twentieth of the work budget each) have not
+    /// improved the best route: the budget becomes an upper bound for small or easy problems.
+    /// Deterministic like the budget. Default `None`: run the whole budget.
+    pub stall_epochs: Option<u32>,
 }
 
 impl Default for SolveOptions {
@@ -99,6 +103,7 @@ impl Default for SolveOptions {
             progress: None,
             cancel: None,
             exact_up_to: 10,
+            stall_epochs: None,
         }
     }
 }
@@ -111,6 +116,8 @@ impl std::fmt::Debug for SolveOptions {
             .field("seed", &self.seed)
             .field("threads", &self.threads)
             .field("initial", &self.initial.as_ref().map(|s| s.len()))
+            .field("exact_up_to", &self.exact_up_to)
+            .field("stall_epochs", &self.stall_epochs)
             .finish()
     }
 }
@@ -304,6 +311,7 @@ fn search_epochs<C: CostModel>(
 ) -> u64 {
     let t0 = clock.started();
     let mut iterations = 0u64;
+    let mut stalled = 0u32;
     let total_kicks = opts.iterations.unwrap_or(u64::MAX);
     let epochs_planned = 20u64;
     let per_epoch = match opts.iterations {
@@ -357,8 +365,13 @@ fn search_epochs<C: CostModel>(
                 handles.into_iter().map(|h| h.join().expect("solver thread panicked")).sum()
             })
         };
+        let before = best.cost;
         share_best(net, ils, best, &mut chains, merge_chains, search_end, eps);
         iterations += done;
+        stalled = if best.cost < before - eps { 0 } else { stalled + 1 };
+        if opts.stall_epochs.is_some_and(|k| stalled >= k) {
+            break;
+        }
         if let Some(cb) = &opts.progress {
             let fraction = budget_used(opts, t0, iterations).unwrap_or(0.0);
             cb(&Progress { elapsed: t0.elapsed(), best_cost: best.cost, iterations, fraction });

@@ -59,6 +59,10 @@ pub struct Args {
     /// Gun speed on transits with the spray off (mm/s).
     #[arg(long, default_value_t = towpath_spray::DEFAULT_TRAVEL_SPEED)]
     pub travel_speed: f64,
+    /// Largest factor by which the gun speed may vary along the passes to even out the
+    /// thickness (speeds between v/F and v·F); 1 keeps the planned speed. Not used with --speed.
+    #[arg(long, default_value_t = towpath_spray::modulation::DEFAULT_MAX_SPEED_CHANGE, value_name = "F")]
+    pub max_speed_change: f64,
     /// Home position X,Y,Z where the path starts.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub home: Option<DVec3>,
@@ -184,6 +188,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     positive("--target-thickness", "target thickness (µm)", args.target_thickness)?;
     positive("--flow", "material flow", args.flow)?;
     positive("--travel-speed", "travel speed", args.travel_speed)?;
+    if !(args.max_speed_change >= 1.0 && args.max_speed_change.is_finite()) {
+        return Err(exit::bad_input(anyhow!(
+            "--max-speed-change {}: give a factor ≥ 1 (1 keeps the planned speeds)",
+            args.max_speed_change
+        )));
+    }
     if let Some(d) = args.spacing {
         positive("--spacing", "pass spacing", d)?;
     }
@@ -224,6 +234,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     params.speed = args.speed;
     params.overrun = args.overrun;
     params.travel_speed = args.travel_speed;
+    params.max_speed_change = args.max_speed_change;
     params.home = args.home;
     params.topology = !args.no_topology;
     params.seq = SeqOptions {
@@ -312,6 +323,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         plan.sequenced.lifted,
         t.cycle_time_s
     );
+    let m = &plan.modulation;
+    if m.rms_after < m.rms_before {
+        outln!(
+            "  speed modulation: {} segments, speeds {:.2}–{:.2}× planned, RMS to target {:.2} % → {:.2} % (coarse points)",
+            m.segments,
+            m.min_speed_factor,
+            m.max_speed_factor,
+            m.rms_before * 100.0,
+            m.rms_after * 100.0
+        );
+    }
     outln!(
         "  solver          : {} ({} rounds, {:.2} s)",
         args.solver.solver,
