@@ -341,7 +341,8 @@ def main():
         for tag, extra in [("towpath", []), ("ga", ["--solver", "ga", "--time-limit", "600"]),
                            ("aco1", ["--solver", "aco1", "--time-limit", "600"]),
                            ("aco2", ["--solver", "aco2", "--time-limit", "600"]),
-                           ("slicer", ["--pattern", "slicer"])]:
+                           ("plain", ["--max-speed-change", "1"]),
+                           ("slicer", ["--pattern", "slicer", "--max-speed-change", "1"])]:
             reps = args.repeats if tag in ("towpath", "slicer") else 1
             r = run_towpath(name, surface, base + extra, tag, reps)
             ev = evaluate(r, target)
@@ -391,20 +392,24 @@ def write_section(res, repeats):
              f"with other engineers' builds: load average {' '.join(ld['before'])} before, "
              f"{' '.join(ld['after'])} after (`{ld['uptime']}`); wall times are inflated accordingly, CPU "
              "times less so. Gun: standoff 200 mm, R 50 mm, beta = 2, 500 mm3/s, target 20 um, "
-             "solver default budget (100 improvement kicks per pass, at least 2000; 1 s time limit), `--threads 2` (wing: standoff 0.8, R 0.2 in the mesh's units).")
+             "solver default budget (100 improvement kicks per pass, at least 2000, stopping after 3 epochs without "
+             "improvement; 1 s time limit), speed modulation on (`--max-speed-change 3`, the default) except in the "
+             "'without modulation' column (`--max-speed-change 1`) and for the slicer (a plain plane slicer has none), "
+             "`--threads 2` (wing: standoff 0.8, R 0.2 in the mesh's units).")
     L.append("")
     L.append("### Thickness and coverage (re-simulated)")
     L.append("")
-    L.append("| part | tris | patches | passes | mean um | RMS (interior) | within ±20 % interior / all | bare tris | crate RMS | slicer RMS | slicer within ±20 % |")
-    L.append("|---|---|---|---|---|---|---|---|---|---|---|")
+    L.append("| part | tris | patches | passes | mean um | RMS (interior) | within ±20 % interior / all | bare tris | crate RMS | without modulation: RMS, within ±20 % | slicer RMS | slicer within ±20 % |")
+    L.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name, row in res.items():
         if name.startswith("_"):
             continue
-        t, sl = row["towpath"], row["slicer"]
+        t, sl, pl = row["towpath"], row["slicer"], row["plain"]["eval"]
         e, c = t["eval"], t["crate"]
         L.append(f"| {name} | {e['triangles']} | {c['patches']} | {c['passes']} | {fmt(e['mean'])} | {fmt(100 * e['rms_rel'])} % | "
                  f"{fmt(100 * e['within20_interior'])} / {fmt(100 * e['within20_all'])} % | {e['bare_triangles']} | "
-                 f"{fmt(100 * c['thickness']['rms_rel'])} % | {fmt(100 * sl['eval']['rms_rel'])} % | "
+                 f"{fmt(100 * c['thickness']['rms_rel'])} % | {fmt(100 * pl['rms_rel'])} %, {fmt(100 * pl['within20_interior'])} % | "
+                 f"{fmt(100 * sl['eval']['rms_rel'])} % | "
                  f"{fmt(100 * sl['eval']['within20_interior'])} % |")
     L.append("")
     L.append("### Integration: travel and time against GA / ACO1 / ACO2 and the plane slicer")

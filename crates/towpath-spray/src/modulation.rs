@@ -71,21 +71,17 @@ pub struct ModulationReport {
     pub spray_time_after_s: f64,
 }
 
-/// Coarse sample points: the centroids of the triangles merged per grid cell of `cell` and per
-/// direction of the normal (its largest component and sign), area-weighted.
-pub fn coarse_points(mesh: &Mesh, cell: f64) -> SamplePoints {
+/// Coarse sample points: points inside the triangles at most `cell` apart
+/// ([`SamplePoints::new`]), merged per grid cell of side `cell` and per direction of the normal
+/// (its largest component and sign), area-weighted.
+pub fn coarse_points(mesh: &Mesh, cell: f64) -> Result<SamplePoints, SprayError> {
+    let fine = SamplePoints::new(mesh, cell)?;
     let mut index: HashMap<(i64, i64, i64, u8), usize> = HashMap::new();
     let mut sums: Vec<(DVec3, DVec3, f64)> = Vec::new();
     let mut faces: Vec<u32> = Vec::new();
-    for f in 0..mesh.num_faces() as u32 {
-        let a = mesh.face_area(f);
-        if !(a > 0.0) {
-            continue;
-        }
-        let [p, q, r] = mesh.corners(f);
-        let c = (p + q + r) / 3.0;
-        let n = mesh.face_normal(f);
-        if !(c.is_finite() && n.is_finite()) {
+    for i in fine.vertices..fine.len() {
+        let (c, n, a) = (fine.positions[i], fine.normals[i], fine.weights[i]);
+        if !(a > 0.0 && c.is_finite() && n.is_finite()) {
             continue;
         }
         let na = n.abs();
@@ -101,7 +97,7 @@ pub fn coarse_points(mesh: &Mesh, cell: f64) -> SamplePoints {
         let key = (g.x as i64, g.y as i64, g.z as i64, axis as u8 * 2 + sign);
         let k = *index.entry(key).or_insert_with(|| {
             sums.push((DVec3::ZERO, DVec3::ZERO, 0.0));
-            faces.push(f);
+            faces.push(fine.faces[i]);
             sums.len() - 1
         });
         sums[k].0 += c * a;
@@ -115,7 +111,7 @@ pub fn coarse_points(mesh: &Mesh, cell: f64) -> SamplePoints {
         s.weights.push(w);
         s.faces.push(f);
     }
-    s
+    Ok(s)
 }
 
 /// Adjusts the durations of the spray segments of `poses` (and so every later time stamp) as
@@ -127,7 +123,7 @@ pub fn modulate(
     target: f64,
     max_change: f64,
 ) -> Result<ModulationReport, SprayError> {
-    let points = coarse_points(mesh, gun.radius * CELL);
+    let points = coarse_points(mesh, gun.radius * CELL)?;
     let inf = influence(gun, poses, &points)?;
     let nseg = inf.segments.len();
     let spray_time: f64 = inf.segments.iter().map(|&j| poses[j as usize + 1].time - poses[j as usize].time).sum();

@@ -136,7 +136,7 @@ fn a_factor_of_one_keeps_the_path() {
 #[test]
 fn coarse_points_keep_the_area_and_split_by_normal() {
     let mesh = common::box_mesh(300.0, 200.0, 100.0, 8);
-    let pts = coarse_points(&mesh, 10.0);
+    let pts = coarse_points(&mesh, 10.0).unwrap();
     let area: f64 = pts.weights.iter().sum();
     assert!((area - mesh.area()).abs() < 1e-6 * mesh.area());
     // a point never mixes faces of the box: its normal is one of the six axes
