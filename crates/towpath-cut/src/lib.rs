@@ -21,6 +21,7 @@
 pub mod contain;
 pub mod error;
 pub mod geom;
+pub mod greedy_match;
 pub mod io;
 pub mod lead;
 pub mod mill;

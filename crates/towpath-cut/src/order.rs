@@ -14,7 +14,8 @@
 //!   problem of its own starting where the previous one ended) unless they are mixed.
 //! - **Search.** With towpath's solver, groups of more than a few pieces are solved by
 //!   [`crate::stroke_search`] (2-opt, Or-opt with reversal and mode choice, segment-swap kicks)
-//!   from a grid nearest-neighbour tour; small ones exactly by `towpath_seq`'s dynamic program.
+//!   from the greedy-edge tour ([`crate::greedy_match`], no precedence) or a grid nearest-neighbour
+//!   tour, whichever is shorter; small ones exactly by `towpath_seq`'s dynamic program.
 //!   Either answer passes `towpath_seq::check`.
 //! - **Refinement.** After the solve, each closed contour's entry is moved along the contour to
 //!   the point that is best between the exit before it and the entry after it, a few passes over
@@ -30,6 +31,7 @@ use towpath_seq::{check, End, Metric, Mode, PointCost, Problem, SolveOptions, St
 use crate::contain::{containers, Shapes};
 use crate::error::CutError;
 use crate::geom::{dist, seg_flatten, Path, Place, P2};
+use crate::greedy_match::greedy_matching;
 use crate::lead::{lead_in, LeadIn};
 use crate::model::{travel, Drawing, Placement};
 use crate::stroke_search::{Budget, StrokeSearch};
@@ -339,7 +341,12 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
             if opts.solver == SolverName::Towpath && greedy_ok && group.len() > opts.solve.exact_up_to {
                 // towpath's solver on stroke tours: the stroke local search (2-opt, Or-opt and
                 // kicks with neighbour lists) from the nearest-neighbour start, anytime.
-                let init: Vec<(usize, u32)> = greedy_steps.iter().map(|s| (s.task.index(), s.mode)).collect();
+                let nn: Vec<(usize, u32)> = greedy_steps.iter().map(|s| (s.task.index(), s.mode)).collect();
+                // Without precedence, the greedy-edge tour when it is the shorter start.
+                let init = match group_pairs.is_empty().then(|| greedy_matching(&ends, at)).flatten() {
+                    Some(g) if tour_length(&ends, at, &g) < tour_length(&ends, at, &nn) => g,
+                    _ => nn,
+                };
                 let mut search = StrokeSearch::new(&ends, &group_pairs, at, &init);
                 let budget = Budget {
                     deadline: opts.solve.time_limit.map(|d| t0 + d),
@@ -624,6 +631,20 @@ pub fn order_merged(drawing: &Drawing, opts: &OrderOptions, tol: f64) -> Result<
     report.travel_before = travel(opts.start, &crate::model::as_drawn(drawing));
     report.travel_after = travel(opts.start, &report.placements);
     Ok(report)
+}
+
+/// Pen-up length of a tour `(piece, mode)` from `start` (free when `None`).
+fn tour_length(ends: &[Vec<(P2, P2)>], start: Option<P2>, tour: &[(usize, u32)]) -> f64 {
+    let mut at = start;
+    let mut total = 0.0;
+    for &(t, m) in tour {
+        let (e, x) = ends[t][m as usize];
+        if let Some(a) = at {
+            total += ((a[0] - e[0]) * (a[0] - e[0]) + (a[1] - e[1]) * (a[1] - e[1])).sqrt();
+        }
+        at = Some(x);
+    }
+    total
 }
 
 /// A nearest-neighbour route: from `start` (or the first task's entry), always the available

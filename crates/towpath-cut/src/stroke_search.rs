@@ -11,7 +11,7 @@
 //! - **mode / direction**: a piece takes its best mode (a closed contour's entry) and
 //!   direction between its neighbours;
 //! - **2-opt**: a segment is reversed (every piece in it runs the other way), the new arcs
-//!   joining a piece to one of its K nearest pieces (neighbour lists from an R-tree over the
+//!   joining a piece to one of its 16 nearest pieces (neighbour lists from an R-tree over the
 //!   piece ends);
 //! - **Or-opt**: a segment of 1–3 pieces moves next to a near piece, forwards or reversed (a
 //!   single piece also with its best mode there);
@@ -33,8 +33,9 @@ use rstar::RTree;
 
 use crate::geom::P2;
 
-/// Pieces each piece keeps as near neighbours.
-const NEIGHBOURS: usize = 8;
+/// Pieces each piece keeps as near neighbours (over all its ends: a stroke's two ends share
+/// them, so about eight each; eight in all left the moves at either end starved).
+const NEIGHBOURS: usize = 16;
 
 /// Longest segment a kick moves.
 const KICK_SEGMENT: usize = 50;
@@ -123,7 +124,7 @@ pub struct StrokeSearch<'a> {
     cut: bool,
     moves: u64,
     /// Longest stretch a move may reverse or pass (with `free`, on the shorter side): bounds
-    /// the work of a move on very large tours (none on up to about 17,000 pieces).
+    /// the work of a move on very large tours (none on up to about 30,000 pieces).
     span: usize,
 }
 
@@ -219,7 +220,7 @@ impl<'a> StrokeSearch<'a> {
             deadline: None,
             cut: false,
             moves: 0,
-            span: (300_000_000 / n.max(1)).max(1000),
+            span: (1_000_000_000 / n.max(1)).max(1000),
         };
         s.cost = s.full_cost();
         s
