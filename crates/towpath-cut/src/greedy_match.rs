@@ -13,6 +13,7 @@ use rstar::primitives::GeomWithData;
 use rstar::RTree;
 
 use crate::geom::P2;
+use crate::point_grid::PointGrid;
 
 /// Links considered per end: its nearest ends of other pieces.
 const CANDIDATES: usize = 10;
@@ -71,12 +72,13 @@ pub fn greedy_matching(ends: &[Vec<(P2, P2)>], start: Option<P2>) -> Option<Vec<
         })
         .collect();
     let nodes: Vec<usize> = (0..2 * n + 1).filter(|&v| slots[v] > 0).collect();
-    let tree = RTree::bulk_load(nodes.iter().map(|&v| GeomWithData::new(point(v), v as u32)).collect::<Vec<_>>());
+    let grid = PointGrid::new(nodes.iter().map(|&v| point(v)).collect());
     let mut cand: Vec<(f64, u32, u32)> = Vec::with_capacity(nodes.len() * CANDIDATES);
+    let mut found = Vec::new();
     for &v in &nodes {
-        let p = point(v);
-        for (item, d2) in tree.nearest_neighbor_iter_with_distance_2(&p).take(CANDIDATES + 2) {
-            let u = item.data as usize;
+        grid.nearest(point(v), CANDIDATES + 2, &mut found);
+        for &(d2, i) in &found {
+            let u = nodes[i as usize];
             if piece(u) != piece(v) && v < u {
                 cand.push((d2, v as u32, u as u32));
             }

@@ -27,6 +27,7 @@ pub mod lead;
 pub mod mill;
 pub mod model;
 pub mod order;
+pub mod point_grid;
 pub mod stroke_search;
 pub mod verify;
 

@@ -28,10 +28,8 @@
 use std::collections::VecDeque;
 use std::time::Instant;
 
-use rstar::primitives::GeomWithData;
-use rstar::RTree;
-
 use crate::geom::P2;
+use crate::point_grid::PointGrid;
 
 /// Pieces each piece keeps as near neighbours (over all its ends: a stroke's two ends share
 /// them, so about eight each; eight in all left the moves at either end starved).
@@ -860,20 +858,21 @@ fn link(a: Option<P2>, b: Option<P2>) -> f64 {
 }
 
 /// The `NEIGHBOURS` pieces nearest each piece (by the distance between any of their ends), from
-/// an R-tree over every entry and exit.
+/// a grid over every distinct entry and exit.
 fn neighbours(ends: &[Vec<(P2, P2)>]) -> Vec<Vec<u32>> {
-    let mut pts: Vec<GeomWithData<[f64; 2], u32>> = Vec::new();
+    let mut pts: Vec<(P2, u32)> = Vec::new();
     for (t, ms) in ends.iter().enumerate() {
         for &(e, x) in ms {
-            pts.push(GeomWithData::new(e, t as u32));
+            pts.push((e, t as u32));
             if x != e {
-                pts.push(GeomWithData::new(x, t as u32));
+                pts.push((x, t as u32));
             }
         }
     }
-    pts.sort_by(|a, b| a.geom().partial_cmp(b.geom()).unwrap_or(std::cmp::Ordering::Equal).then(a.data.cmp(&b.data)));
-    pts.dedup_by(|a, b| a.geom() == b.geom() && a.data == b.data);
-    let tree = RTree::bulk_load(pts);
+    pts.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal).then(a.1.cmp(&b.1)));
+    pts.dedup();
+    let grid = PointGrid::new(pts.iter().map(|p| p.0).collect());
+    let mut found = Vec::new();
     let mut out = Vec::with_capacity(ends.len());
     for (t, ms) in ends.iter().enumerate() {
         let mut best: Vec<(f64, u32)> = Vec::new();
@@ -881,12 +880,30 @@ fn neighbours(ends: &[Vec<(P2, P2)>]) -> Vec<Vec<u32>> {
         qs.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
         qs.dedup();
         for q in qs {
+            // the nearest points, more of them while other pieces' many entry points (or this
+            // piece's own) crowd out NEIGHBOURS distinct pieces
+            let mut k = NEIGHBOURS + 2;
+            loop {
+                grid.nearest(q, k, &mut found);
+                let mut seen: Vec<u32> = Vec::with_capacity(NEIGHBOURS);
+                for &(_, i) in &found {
+                    let piece = pts[i as usize].1;
+                    if piece as usize != t && !seen.contains(&piece) {
+                        seen.push(piece);
+                    }
+                }
+                if seen.len() >= NEIGHBOURS || found.len() < k {
+                    break;
+                }
+                k *= 2;
+            }
             let mut got = 0;
-            for (item, d2) in tree.nearest_neighbor_iter_with_distance_2(&q).take(4 * NEIGHBOURS + 2 * ms.len()) {
-                if item.data as usize == t {
+            for &(d2, i) in &found {
+                let piece = pts[i as usize].1;
+                if piece as usize == t {
                     continue;
                 }
-                best.push((d2, item.data));
+                best.push((d2, piece));
                 got += 1;
                 if got >= NEIGHBOURS {
                     break;
