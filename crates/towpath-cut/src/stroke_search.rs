@@ -67,10 +67,12 @@ pub struct Stats {
     pub moves: u64,
 }
 
-/// One journal entry: a physical reversal (undone by doing it again) or a piece's old state.
+/// One journal entry: a physical reversal (undone by doing it again), a rotation (undone by
+/// the opposite one) or a piece's old state.
 #[derive(Clone, Copy)]
 enum Op {
     Rev { i: usize, j: usize, toggled: bool },
+    Rot { lo: usize, hi: usize, k: usize, left: bool },
     State { v: u32, mode: u32, flipped: bool },
 }
 
@@ -430,6 +432,7 @@ impl<'a> StrokeSearch<'a> {
                     self.mode[v as usize] = mode;
                     self.flipped[v as usize] = flipped;
                 }
+                Op::Rot { lo, hi, k, left } => self.rotate_physical(lo, hi, k, !left),
             }
         }
         self.cost = cost;
@@ -709,7 +712,9 @@ impl<'a> StrokeSearch<'a> {
         true
     }
 
-    /// Moves `s1..=sk` between `c` and `next(c)`, reversed or not, by reversals.
+    /// Moves `s1..=sk` between `c` and `next(c)`, reversed or not: by rotating the stretch it
+    /// passes (one pass over it) when that stretch does not wrap round the array's end, else by
+    /// reversals.
     fn move_segment(&mut self, s1: u32, sk: u32, c: u32, reversed: bool) {
         let (p, q, d) = (self.prev(s1), self.next(sk), self.next(c));
         let forward = if self.free {
@@ -718,6 +723,26 @@ impl<'a> StrokeSearch<'a> {
         } else {
             c != self.depot() && self.pos[c as usize] > self.pos[sk as usize]
         };
+        let k = self.seg_len(s1, sk);
+        let pos = |v: u32| self.pos[v as usize];
+        // The physical stretch [lo, hi] holding the segment and what it passes, and whether the
+        // segment goes to its high end (rotate left) or its low end (rotate right).
+        let (lo, hi, left) = match (forward, self.orient) {
+            (true, false) => (pos(s1), pos(c), true),
+            (true, true) => (pos(c), pos(s1), false),
+            (false, false) => (pos(d), pos(sk), false),
+            (false, true) => (pos(sk), pos(d), true),
+        };
+        if lo < hi && hi - lo + 1 > k {
+            self.rotate_physical(lo, hi, k, left);
+            if self.journaling {
+                self.journal.push(Op::Rot { lo, hi, k, left });
+            }
+            if reversed {
+                self.reverse(s1, sk);
+            }
+            return;
+        }
         if forward {
             // p S q .. c d  →  p c .. q S^r d  →  p q .. c S^r d
             self.reverse(s1, c);
@@ -729,6 +754,19 @@ impl<'a> StrokeSearch<'a> {
         }
         if !reversed {
             self.reverse(sk, s1);
+        }
+    }
+
+    /// Rotates `seq[lo..=hi]` by `k` places (left: the first `k` go to the end), keeping `pos`.
+    fn rotate_physical(&mut self, lo: usize, hi: usize, k: usize, left: bool) {
+        let part = &mut self.seq[lo..=hi];
+        if left {
+            part.rotate_left(k);
+        } else {
+            part.rotate_right(k);
+        }
+        for i in lo..=hi {
+            self.pos[self.seq[i] as usize] = i;
         }
     }
 
