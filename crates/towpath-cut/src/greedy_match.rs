@@ -190,6 +190,21 @@ pub fn greedy_matching(ends: &[Vec<(P2, P2)>], start: Option<P2>) -> Option<Vec<
     (tour.len() == n).then_some(tour)
 }
 
+/// Pen-up length of a tour `(piece, mode)` from `start` (free when `None`): the links from each
+/// piece's exit to the next one's entry.
+pub fn pen_up(ends: &[Vec<(P2, P2)>], start: Option<P2>, tour: &[(usize, u32)]) -> f64 {
+    let mut at = start;
+    let mut total = 0.0;
+    for &(t, m) in tour {
+        let (e, x) = ends[t][m as usize];
+        if let Some(a) = at {
+            total += ((a[0] - e[0]) * (a[0] - e[0]) + (a[1] - e[1]) * (a[1] - e[1])).sqrt();
+        }
+        at = Some(x);
+    }
+    total
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -215,19 +230,6 @@ mod tests {
                 }
             })
             .collect()
-    }
-
-    fn pen_up(ends: &[Vec<(P2, P2)>], start: Option<P2>, tour: &[(usize, u32)]) -> f64 {
-        let mut at = start;
-        let mut total = 0.0;
-        for &(t, m) in tour {
-            let (e, x) = ends[t][m as usize];
-            if let Some(a) = at {
-                total += ((a[0] - e[0]).powi(2) + (a[1] - e[1]).powi(2)).sqrt();
-            }
-            at = Some(x);
-        }
-        total
     }
 
     #[test]

@@ -31,7 +31,7 @@ use towpath_seq::{check, End, Metric, Mode, PointCost, Problem, SolveOptions, St
 use crate::contain::{containers, Shapes};
 use crate::error::CutError;
 use crate::geom::{dist, seg_flatten, Path, Place, P2};
-use crate::greedy_match::greedy_matching;
+use crate::greedy_match::{greedy_matching, pen_up};
 use crate::lead::{lead_in, LeadIn};
 use crate::model::{travel, Drawing, Placement};
 use crate::stroke_search::{Budget, StrokeSearch};
@@ -344,7 +344,7 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
                 let nn: Vec<(usize, u32)> = greedy_steps.iter().map(|s| (s.task.index(), s.mode)).collect();
                 // Without precedence, the greedy-edge tour when it is the shorter start.
                 let init = match group_pairs.is_empty().then(|| greedy_matching(&ends, at)).flatten() {
-                    Some(g) if tour_length(&ends, at, &g) < tour_length(&ends, at, &nn) => g,
+                    Some(g) if pen_up(&ends, at, &g) < pen_up(&ends, at, &nn) => g,
                     _ => nn,
                 };
                 let mut search = StrokeSearch::new(&ends, &group_pairs, at, &init);
@@ -631,20 +631,6 @@ pub fn order_merged(drawing: &Drawing, opts: &OrderOptions, tol: f64) -> Result<
     report.travel_before = travel(opts.start, &crate::model::as_drawn(drawing));
     report.travel_after = travel(opts.start, &report.placements);
     Ok(report)
-}
-
-/// Pen-up length of a tour `(piece, mode)` from `start` (free when `None`).
-fn tour_length(ends: &[Vec<(P2, P2)>], start: Option<P2>, tour: &[(usize, u32)]) -> f64 {
-    let mut at = start;
-    let mut total = 0.0;
-    for &(t, m) in tour {
-        let (e, x) = ends[t][m as usize];
-        if let Some(a) = at {
-            total += ((a[0] - e[0]) * (a[0] - e[0]) + (a[1] - e[1]) * (a[1] - e[1])).sqrt();
-        }
-        at = Some(x);
-    }
-    total
 }
 
 /// A nearest-neighbour route: from `start` (or the first task's entry), always the available

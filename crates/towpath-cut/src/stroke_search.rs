@@ -999,16 +999,7 @@ mod tests {
 
     /// The route's pen-up length, recomputed from the steps alone.
     fn route_cost(ends: &[Vec<(P2, P2)>], start: Option<P2>, steps: &[(usize, u32)]) -> f64 {
-        let mut at = start;
-        let mut c = 0.0;
-        for &(t, m) in steps {
-            let (e, x) = ends[t][m as usize];
-            if let Some(a) = at {
-                c += ((a[0] - e[0]).powi(2) + (a[1] - e[1]).powi(2)).sqrt();
-            }
-            at = Some(x);
-        }
-        c
+        crate::greedy_match::pen_up(ends, start, steps)
     }
 
     fn feasible(ends: &[Vec<(P2, P2)>], pairs: &[(usize, usize)], steps: &[(usize, u32)]) -> bool {
