@@ -918,22 +918,17 @@ fn neighbours(ends: &[Vec<(P2, P2)>]) -> Vec<Vec<u32>> {
         qs.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
         qs.dedup();
         for q in qs {
-            // the nearest points, more of them while other pieces' many entry points (or this
-            // piece's own) crowd out NEIGHBOURS distinct pieces
+            // the NEIGHBOURS nearest points of other pieces: more points while this piece's own
+            // entry candidates crowd them out (at most as many as the R-tree query took)
+            let k_max = 4 * NEIGHBOURS + 2 * ms.len();
             let mut k = NEIGHBOURS + 2;
             loop {
                 grid.nearest(q, k, &mut found);
-                let mut seen: Vec<u32> = Vec::with_capacity(NEIGHBOURS);
-                for &(_, i) in &found {
-                    let piece = pts[i as usize].1;
-                    if piece as usize != t && !seen.contains(&piece) {
-                        seen.push(piece);
-                    }
-                }
-                if seen.len() >= NEIGHBOURS || found.len() < k {
+                let others = found.iter().filter(|&&(_, i)| pts[i as usize].1 as usize != t).count();
+                if others >= NEIGHBOURS || found.len() < k || k >= k_max {
                     break;
                 }
-                k *= 2;
+                k = (2 * k).min(k_max);
             }
             let mut got = 0;
             for &(d2, i) in &found {
