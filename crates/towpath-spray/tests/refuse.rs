@@ -25,6 +25,8 @@ fn bad_parameters_and_meshes_are_refused() {
     check(&|p| p.gun.profile = Profile::Beta { beta: 0.5 }, "β");
     check(&|p| p.spacing = Some(500.0), "spacing");
     check(&|p| p.max_deviation_deg = 95.0, "deviation");
+    check(&|p| p.max_speed_change = 0.5, "speed change");
+    check(&|p| p.max_speed_change = f64::INFINITY, "speed change");
     // An empty mesh and a mesh whose only triangle has no area.
     // (The mesh builder may refuse them first; either way there is an error, not a panic.)
     let refuse = |soup: &Soup| match Mesh::build(soup, &BuildOptions::default()) {
