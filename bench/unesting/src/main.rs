@@ -1,77 +1,102 @@
-//! Runs u-nesting-cutting's `optimize_cutting_path` on a sheet of parts already placed (the
-//! same contours `towpath order` gets as SVG), for `bench/unesting.py`.
+//! Runs u-nesting-cutting's cutting-path optimisation on one sheet of placed parts.
 //!
-//! Input JSON: `{"parts": [{"outer": [[x, y], ...], "holes": [[[x, y], ...], ...]}, ...]}` in
-//! sheet coordinates. Each part becomes a `Geometry2D` placed at (0, 0) without rotation, so the
-//! crate sees exactly these coordinates. Output JSON: the contours in the crate's order with
-//! their pierce points, the crate's own rapid total and the wall time of the call.
+//!     unesting-peer SHEET.json [--time-limit-ms N] [--max-2opt-iterations N] > ORDER.json
 //!
-//!     unesting-peer SHEET.json [PIERCE_CANDIDATES]
+//! SHEET.json: `{"parts": [{"id": "p0", "outer": [[x, y], ...], "holes": [[[x, y], ...], ...]}, ...]}`,
+//! every polygon already in sheet coordinates (no closing vertex repeated).
+//!
+//! The crate's entry point, `optimize_cutting_path(&SolveResult, &[Geometry2D], &CuttingConfig)`,
+//! takes a nesting result. Each part becomes one `Geometry2D` whose outer ring and holes are the
+//! placed polygons, and the `SolveResult` holds one placement per part at (0, 0) with no
+//! rotation, so the contours the crate extracts are exactly the sheet's polygons (the same ones
+//! written to the SVG that `towpath order` reads). Config: `CuttingConfig::default()` of
+//! u-nesting-cutting 0.28.2 (home (0, 0), kerf 0, pierce_candidates 1 = nearest point on the
+//! contour, nearest neighbour then constrained 2-opt with max_2opt_iterations 1000 and
+//! time_limit_ms 5000, exterior CCW / holes CW). The two options change only those two fields
+//! (for diagnostics: `--time-limit-ms 0` = no wall-clock limit on the 2-opt,
+//! `--max-2opt-iterations 0` = nearest neighbour only); the benchmark table uses neither.
+//!
+//! Output: `{"seconds": wall time of optimize_cutting_path, "total_rapid_distance": its own
+//! figure, "sequence": [{"contour": "p0o" | "p0h1", "contour_id", "pierce": [x, y],
+//! "direction": "ccw" | "cw"}, ...]}`. Contour names: part id + "o" for the outer contour,
+//! + "h" + hole index for holes (the ids used in the SVG).
 
 use std::time::Instant;
 
 use serde_json::{json, Value};
 use u_nesting_core::{Placement, SolveResult};
-use u_nesting_cutting::{optimize_cutting_path, ContourType, CuttingConfig};
+use u_nesting_cutting::{optimize_cutting_path, CutDirection, CuttingConfig};
 use u_nesting_d2::Geometry2D;
 
 fn ring(v: &Value) -> Vec<(f64, f64)> {
     v.as_array()
-        .map(|pts| {
-            pts.iter()
-                .filter_map(|p| Some((p.get(0)?.as_f64()?, p.get(1)?.as_f64()?)))
-                .collect()
-        })
-        .unwrap_or_default()
+        .expect("polygon: array of points")
+        .iter()
+        .map(|p| (p[0].as_f64().expect("x"), p[1].as_f64().expect("y")))
+        .collect()
 }
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let text = std::fs::read_to_string(&args[1]).expect("read the sheet");
-    let sheet: Value = serde_json::from_str(&text).expect("parse the sheet");
-    let parts = sheet["parts"].as_array().expect("parts");
-    let mut geoms = Vec::new();
-    let mut result = SolveResult::<f64>::new();
-    for (i, p) in parts.iter().enumerate() {
-        let id = format!("P{i}");
-        let mut g = Geometry2D::new(id.clone()).with_polygon(ring(&p["outer"]));
-        for h in p["holes"].as_array().into_iter().flatten() {
-            g = g.with_hole(ring(h));
-        }
-        geoms.push(g);
-        result.placements.push(Placement::new_2d(id, 0, 0.0, 0.0, 0.0));
-    }
+    let path = args.get(1).expect("usage: unesting-peer SHEET.json [--time-limit-ms N] [--max-2opt-iterations N]");
     let mut config = CuttingConfig::default();
-    if let Some(k) = args.get(2).and_then(|s| s.parse().ok()) {
-        config.pierce_candidates = k;
-    }
-    let t0 = Instant::now();
-    let path = optimize_cutting_path(&result, &geoms, &config);
-    let seconds = t0.elapsed().as_secs_f64();
-    // Contour ids: per placement, its exterior and then its holes (extract_contours' order).
-    let mut names = Vec::new();
-    for (i, p) in parts.iter().enumerate() {
-        names.push(json!({"part": i, "hole": null}));
-        for k in 0..p["holes"].as_array().map_or(0, |h| h.len()) {
-            names.push(json!({"part": i, "hole": k}));
+    let mut i = 2;
+    while i < args.len() {
+        let value = || args.get(i + 1).and_then(|v| v.parse().ok()).expect("option value: a whole number");
+        match args[i].as_str() {
+            "--time-limit-ms" => config.time_limit_ms = value() as u64,
+            "--max-2opt-iterations" => config.max_2opt_iterations = value(),
+            other => panic!("unknown option {other}"),
         }
+        i += 2;
     }
-    let order: Vec<Value> = path
+    let sheet: Value = serde_json::from_str(&std::fs::read_to_string(&path).expect("read sheet")).expect("JSON");
+    let parts = sheet["parts"].as_array().expect("parts");
+
+    let mut geometries = Vec::with_capacity(parts.len());
+    let mut result: SolveResult<f64> = SolveResult::new();
+    // Contour names in the order extract_contours numbers them: per placement, the exterior,
+    // then the holes in order.
+    let mut names = Vec::new();
+    for part in parts {
+        let id = part["id"].as_str().expect("id").to_string();
+        let mut g = Geometry2D::new(id.clone()).with_polygon(ring(&part["outer"]));
+        names.push(format!("{id}o"));
+        for (k, h) in part["holes"].as_array().map(|a| a.as_slice()).unwrap_or(&[]).iter().enumerate() {
+            g = g.with_hole(ring(h));
+            names.push(format!("{id}h{k}"));
+        }
+        geometries.push(g);
+        result.placements.push(Placement::new_2d(id.into(), 0, 0.0, 0.0, 0.0));
+    }
+    result.boundaries_used = 1;
+
+    let t0 = Instant::now();
+    let path = optimize_cutting_path(&result, &geometries, &config).expect("optimize_cutting_path");
+    let seconds = t0.elapsed().as_secs_f64();
+
+    let sequence: Vec<Value> = path
         .sequence
         .iter()
         .map(|s| {
             json!({
-                "contour": names.get(s.contour_id).cloned().unwrap_or(Value::Null),
-                "interior": s.contour_type == ContourType::Interior,
+                "contour": names[s.contour_id],
+                "contour_id": s.contour_id,
                 "pierce": [s.pierce_point.0, s.pierce_point.1],
+                "direction": match s.cut_direction { CutDirection::Ccw => "ccw", CutDirection::Cw => "cw" },
             })
         })
         .collect();
     let out = json!({
-        "order": order,
-        "total_rapid_distance": path.total_rapid_distance,
-        "pierces": path.total_pierces,
+        "tool": "u-nesting-cutting 0.28.2",
+        "config": "CuttingConfig::default()",
+        "time_limit_ms": config.time_limit_ms,
+        "max_2opt_iterations": config.max_2opt_iterations,
         "seconds": seconds,
+        "computation_time_ms": path.computation_time_ms,
+        "total_rapid_distance": path.total_rapid_distance,
+        "total_pierces": path.total_pierces,
+        "sequence": sequence,
     });
     println!("{out}");
 }

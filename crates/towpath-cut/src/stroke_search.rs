@@ -31,9 +31,12 @@ use std::time::Instant;
 use crate::geom::P2;
 use crate::point_grid::PointGrid;
 
-/// Pieces each piece keeps as near neighbours (over all its ends: a stroke's two ends share
-/// them, so about eight each; eight in all left the moves at either end starved).
-const NEIGHBOURS: usize = 16;
+/// Near pieces each closed contour keeps (its entry candidates all lie on one loop).
+const NEIGHBOURS: usize = 8;
+/// Near pieces each open stroke keeps: its two ends share them, about eight each (eight in all
+/// left the moves at either end starved on random strokes; sixteen for closed contours made the
+/// search slower and worse on nested-part sheets).
+const STROKE_NEIGHBOURS: usize = 16;
 
 /// Longest segment a kick moves.
 const KICK_SEGMENT: usize = 50;
@@ -895,7 +898,8 @@ fn link(a: Option<P2>, b: Option<P2>) -> f64 {
     }
 }
 
-/// The `NEIGHBOURS` pieces nearest each piece (by the distance between any of their ends), from
+/// The nearest pieces of each piece ([`NEIGHBOURS`] for a closed contour, [`STROKE_NEIGHBOURS`] for an
+/// open stroke; by the distance between any of their ends), from
 /// a grid over every distinct entry and exit.
 fn neighbours(ends: &[Vec<(P2, P2)>]) -> Vec<Vec<u32>> {
     let mut pts: Vec<(P2, u32)> = Vec::new();
@@ -913,19 +917,20 @@ fn neighbours(ends: &[Vec<(P2, P2)>]) -> Vec<Vec<u32>> {
     let mut found = Vec::new();
     let mut out = Vec::with_capacity(ends.len());
     for (t, ms) in ends.iter().enumerate() {
+        let want = if ms.iter().all(|&(e, x)| e == x) { NEIGHBOURS } else { STROKE_NEIGHBOURS };
         let mut best: Vec<(f64, u32)> = Vec::new();
         let mut qs: Vec<P2> = ms.iter().flat_map(|&(e, x)| [e, x]).collect();
         qs.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
         qs.dedup();
         for q in qs {
-            // the NEIGHBOURS nearest points of other pieces: more points while this piece's own
+            // the `want` nearest points of other pieces: more points while this piece's own
             // entry candidates crowd them out (at most as many as the R-tree query took)
-            let k_max = 4 * NEIGHBOURS + 2 * ms.len();
-            let mut k = NEIGHBOURS + 2;
+            let k_max = 4 * want + 2 * ms.len();
+            let mut k = want + 2;
             loop {
                 grid.nearest(q, k, &mut found);
                 let others = found.iter().filter(|&&(_, i)| pts[i as usize].1 as usize != t).count();
-                if others >= NEIGHBOURS || found.len() < k || k >= k_max {
+                if others >= want || found.len() < k || k >= k_max {
                     break;
                 }
                 k = (2 * k).min(k_max);
@@ -938,17 +943,17 @@ fn neighbours(ends: &[Vec<(P2, P2)>]) -> Vec<Vec<u32>> {
                 }
                 best.push((d2, piece));
                 got += 1;
-                if got >= NEIGHBOURS {
+                if got >= want {
                     break;
                 }
             }
         }
         best.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let mut list: Vec<u32> = Vec::with_capacity(NEIGHBOURS);
+        let mut list: Vec<u32> = Vec::with_capacity(want);
         for (_, u) in best {
             if !list.contains(&u) {
                 list.push(u);
-                if list.len() == NEIGHBOURS {
+                if list.len() == want {
                     break;
                 }
             }
