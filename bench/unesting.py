@@ -38,6 +38,8 @@ import sys
 import time
 from pathlib import Path
 
+from order import replace_between  # bench/order.py (stdlib only at import)
+
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "bench" / "out" / "unesting"
 TOWPATH = ROOT / "target" / "release" / "towpath"
@@ -382,11 +384,6 @@ def table(rows):
                    f"{t['rapid']:,.1f} mm | {cell(t, 'solve')} | {t['rapid'] / u['rapid']:.3f} | "
                    f"{u['violations']}, {t['violations']} |")
     return "\n".join(out)
-
-
-def replace_between(text, start, end, body):
-    a, b = text.index(start) + len(start), text.index(end)
-    return text[:a] + "\n" + body + "\n" + text[b:]
 
 
 def main():

@@ -142,13 +142,9 @@ pub fn greedy_matching(ends: &[Vec<(P2, P2)>], start: Option<P2>) -> Option<Vec<
             done[t] = true;
             tour.push((t, mode_entering(v)));
             let x = other_end(v);
-            // the link out of x that is not the one we came in by
-            let out = links[x].iter().copied().find(|&u| u != u32::MAX && u != from && (u as usize) / 2 != t);
-            let out = match kind[t] {
-                // a closed contour's point holds both links: the way out is the other one
-                Kind::Closed => links[x].iter().copied().find(|&u| u != u32::MAX && u != from),
-                Kind::Open { .. } => out,
-            };
+            // (a closed contour's point holds both links: the way out is the one not come in by;
+            // an open stroke's exit end holds at most one, never the way in)
+            let out = links[x].iter().copied().find(|&u| u != u32::MAX && u != from);
             match out {
                 Some(u) if (u as usize) != 2 * n && !done[(u as usize) / 2] => {
                     from = x as u32;

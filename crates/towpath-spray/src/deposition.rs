@@ -219,12 +219,27 @@ struct Cone {
     r2max: f64,
     h2: f64,
     reach: f64,
+    /// Radius of the footprint at `reach`.
+    base: f64,
 }
 
 impl Cone {
     fn new(gun: &Gun) -> Cone {
         let kernel = gun.profile.kernel(gun.radius);
-        Cone { r2max: kernel.radius2(), kernel, h2: gun.standoff * gun.standoff, reach: REACH * gun.standoff }
+        let reach = REACH * gun.standoff;
+        Cone { r2max: kernel.radius2(), kernel, h2: gun.standoff * gun.standoff, reach, base: gun.radius * REACH }
+    }
+
+    /// A box holding everything a step's cone reaches: from the gun to the disk of radius
+    /// `base` at `reach` along the axis.
+    fn bounds(&self, st: &Step) -> (DVec3, DVec3) {
+        let c = st.g + st.a * self.reach;
+        let ext = DVec3::new(
+            self.base * (1.0 - st.a.x * st.a.x).max(0.0).sqrt(),
+            self.base * (1.0 - st.a.y * st.a.y).max(0.0).sqrt(),
+            self.base * (1.0 - st.a.z * st.a.z).max(0.0).sqrt(),
+        );
+        (st.g.min(c - ext), st.g.max(c + ext))
     }
 
     /// Thickness (µm) one step leaves at point `p` with unit normal `n`.
@@ -309,21 +324,12 @@ pub fn simulate(gun: &Gun, poses: &[Pose], points: &SamplePoints) -> Result<Vec<
     }
     let grid = Grid::new(&points.positions, gun.radius);
     // Scatter: every step to the non-empty cells its cone's bounding box touches.
-    let h = gun.standoff;
-    let reach = REACH * h;
-    let base = gun.radius * REACH;
+    let cone = Cone::new(gun);
     let mut pairs: Vec<(u32, u32)> = steps
         .par_iter()
         .enumerate()
         .fold(Vec::new, |mut acc, (si, st)| {
-            let c = st.g + st.a * reach;
-            let ext = DVec3::new(
-                base * (1.0 - st.a.x * st.a.x).max(0.0).sqrt(),
-                base * (1.0 - st.a.y * st.a.y).max(0.0).sqrt(),
-                base * (1.0 - st.a.z * st.a.z).max(0.0).sqrt(),
-            );
-            let lo = st.g.min(c - ext);
-            let hi = st.g.max(c + ext);
+            let (lo, hi) = cone.bounds(st);
             grid.for_cells(lo, hi, |cell| acc.push((cell, si as u32)));
             acc
         })
@@ -343,7 +349,6 @@ pub fn simulate(gun: &Gun, poses: &[Pose], points: &SamplePoints) -> Result<Vec<
         bounds.push((i, j));
         i = j;
     }
-    let reach_of = Cone::new(gun);
     let results: Vec<(u32, Vec<f64>)> = bounds
         .par_iter()
         .map(|&(i, j)| {
@@ -354,7 +359,7 @@ pub fn simulate(gun: &Gun, poses: &[Pose], points: &SamplePoints) -> Result<Vec<
                 let st = steps[si as usize];
                 for (slot, &pi) in pts.iter().enumerate() {
                     let pi = pi as usize;
-                    vals[slot] += reach_of.amount(&st, points.positions[pi], points.normals[pi]);
+                    vals[slot] += cone.amount(&st, points.positions[pi], points.normals[pi]);
                 }
             }
             (cell, vals)
@@ -404,19 +409,13 @@ pub fn influence(gun: &Gun, poses: &[Pose], points: &SamplePoints) -> Result<Inf
     }
     let grid = Grid::new(&points.positions, gun.radius);
     let cone = Cone::new(gun);
-    let base = gun.radius * REACH;
     let columns: Vec<Vec<(u32, f64)>> = runs
         .par_iter()
         .map(|&(i, j)| {
             let mut col: Vec<(u32, f64)> = Vec::new();
             for st in &steps[i..j] {
-                let c = st.g + st.a * cone.reach;
-                let ext = DVec3::new(
-                    base * (1.0 - st.a.x * st.a.x).max(0.0).sqrt(),
-                    base * (1.0 - st.a.y * st.a.y).max(0.0).sqrt(),
-                    base * (1.0 - st.a.z * st.a.z).max(0.0).sqrt(),
-                );
-                grid.for_cells(st.g.min(c - ext), st.g.max(c + ext), |cell| {
+                let (lo, hi) = cone.bounds(st);
+                grid.for_cells(lo, hi, |cell| {
                     for &pi in grid.points(cell) {
                         let v = cone.amount(st, points.positions[pi as usize], points.normals[pi as usize]);
                         if v > 0.0 {
