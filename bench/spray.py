@@ -273,6 +273,26 @@ def run_towpath(name, surface, opts, tag, repeats):
             "wall": statistics.median(walls), "cpu": statistics.median(cpus), "walls": walls}
 
 
+def path_travel(path):
+    """Travel (spray off) summed from a written path's poses, with this script's own code."""
+    poses = json.load(open(path))["poses"]
+    return sum(math.dist(p0["position"], p1["position"]) for p0, p1 in zip(poses, poses[1:]) if not p0["spray"])
+
+
+def seed_runs(name, surface, opts, tag, extra, seeds):
+    """Runs one solver with seeds 1..seeds: travel from the written poses and solver time."""
+    path = os.path.join(OUT, f"{name}_{tag}_seed.json")
+    travel, seconds = [], []
+    for seed in range(1, seeds + 1):
+        cmd = [BIN, "spray", surface, *opts, *extra, "--seed", str(seed), "-o", path, "--json"]
+        res = subprocess.run(cmd, capture_output=True, text=True)
+        if res.returncode != 0:
+            raise SystemExit(f"{' '.join(cmd)} failed ({res.returncode}):\n{res.stderr}")
+        travel.append(path_travel(path))
+        seconds.append(json.loads(res.stdout)["solver_seconds"])
+    return {"travel": travel, "seconds": seconds}
+
+
 CASES = [
     # name, surface, options, target (um)
     ("plate", "plane:a=600,b=400", ["--standoff", "200", "--spray-radius", "50"], 20.0),
@@ -317,6 +337,8 @@ def main():
     ensure_numpy()
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--seeds", type=int, default=5,
+                    help="seeds per solver for the travel/solver-time comparison (medians)")
     ap.add_argument("--no-write", action="store_true")
     ap.add_argument("--only", default=None)
     ap.add_argument("--sensitivity", action="store_true",
@@ -355,6 +377,14 @@ def main():
                   f"cycle {ev['cycle']:7.1f} s  RMS {100 * ev['rms_rel']:6.2f} % (crate {100 * s['thickness']['rms_rel']:6.2f} %) "
                   f"within20 {100 * ev['within20_interior']:6.2f} %/{100 * ev['within20_all']:6.2f} % bare {ev['bare_triangles']} "
                   f"solver {s['solver_seconds']:.3f} s wall {r['wall']:.2f} s cpu {r['cpu']:.2f} s", flush=True)
+        row["seeds"] = {}
+        for tag, extra in [("towpath", []), ("ga", ["--solver", "ga", "--time-limit", "600"]),
+                           ("aco1", ["--solver", "aco1", "--time-limit", "600"]),
+                           ("aco2", ["--solver", "aco2", "--time-limit", "600"])]:
+            sr = seed_runs(name, surface, base, tag, extra, args.seeds)
+            row["seeds"][tag] = sr
+            print(f"{name:11s} {tag:8s} seeds 1-{args.seeds}: travel median {statistics.median(sr['travel']):9.2f} "
+                  f"(max {max(sr['travel']):9.2f}) solver median {1e3 * statistics.median(sr['seconds']):9.3f} ms", flush=True)
         results[name] = row
     # Speed: 200k triangles.
     speed = {}
@@ -379,21 +409,22 @@ def main():
     with open(os.path.join(OUT, "results.json"), "w") as fh:
         json.dump(results, fh, indent=1)
     if not args.no_write:
-        write_section(results, args.repeats)
+        write_section(results, args.repeats, args.seeds)
 
 
-def write_section(res, repeats):
+def write_section(res, repeats, seeds):
     L = [SECTION, ""]
     ld = res["_load"]
     L.append("`python3 bench/spray.py` (numpy re-simulation of the written poses with its own deposition code, "
              "on the welded mesh of each run's thickness PLY; sample points inside every triangle, edge band one "
              f"spray radius wide left out of RMS). Timings: median of {repeats} runs of the towpath and slicer "
-             "configurations (GA/ACO once), wall and CPU time of the process. The machine (2 cores) was shared "
+             "configurations (GA/ACO once, seed 1), wall and CPU time of the process. The machine (2 cores) was shared "
              f"with other engineers' builds: load average {' '.join(ld['before'])} before, "
              f"{' '.join(ld['after'])} after (`{ld['uptime']}`); wall times are inflated accordingly, CPU "
              "times less so. Gun: standoff 200 mm, R 50 mm, beta = 2, 500 mm3/s, target 20 um, "
-             "solver default budget (100 improvement kicks per pass, at least 2000, stopping after 3 epochs without "
-             "improvement; 1 s time limit), speed modulation on (`--max-speed-change 3`, the default) except in the "
+             "solver default budget (towpath_seq::solve_reversible: 15 improvement kicks per pass, at least 100, stopping "
+             "after 3/20 of the budget without improvement but not before as many kicks again as the best took; 1 s "
+             "time limit), speed modulation on (`--max-speed-change 3`, the default) except in the "
              "'without modulation' column (`--max-speed-change 1`) and for the slicer (a plain plane slicer has none), "
              "`--threads 2` (wing: standoff 0.8, R 0.2 in the mesh's units).")
     L.append("")
@@ -414,9 +445,9 @@ def write_section(res, repeats):
     L.append("")
     L.append("### Integration: travel and time against GA / ACO1 / ACO2 and the plane slicer")
     L.append("")
-    L.append("Travel (mm, spray off, summed from the written poses), cycle time (s), solver time (s).")
+    L.append("Seed 1. Travel (mm, spray off, summed from the written poses), cycle time (s), solver time (ms).")
     L.append("")
-    L.append("| part | towpath travel | GA | ACO1 | ACO2 | towpath solver s | GA s | ACO1 s | ACO2 s | best paper / towpath time | cycle s towpath | cycle s slicer | wall s (cpu s) towpath | wall s slicer |")
+    L.append("| part | towpath travel | GA | ACO1 | ACO2 | towpath solver ms | GA ms | ACO1 ms | ACO2 ms | best paper / towpath time | cycle s towpath | cycle s slicer | wall s (cpu s) towpath | wall s slicer |")
     L.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name, row in res.items():
         if name.startswith("_"):
@@ -426,9 +457,30 @@ def write_section(res, repeats):
         ss = {k: row[k]["crate"]["solver_seconds"] for k in ("towpath", "ga", "aco1", "aco2")}
         best = min(("ga", "aco1", "aco2"), key=lambda k: tr[k])
         ratio = ss[best] / ss["towpath"] if ss["towpath"] > 0 else float("inf")
-        L.append(f"| {name} | {tr['towpath']:.0f} | {tr['ga']:.0f} | {tr['aco1']:.0f} | {tr['aco2']:.0f} | {ss['towpath']:.3f} | "
-                 f"{ss['ga']:.3f} | {ss['aco1']:.3f} | {ss['aco2']:.3f} | {ratio:.1f}x ({best}) | {tw['eval']['cycle']:.1f} | "
+        L.append(f"| {name} | {tr['towpath']:.0f} | {tr['ga']:.0f} | {tr['aco1']:.0f} | {tr['aco2']:.0f} | {1e3 * ss['towpath']:.3f} | "
+                 f"{1e3 * ss['ga']:.3f} | {1e3 * ss['aco1']:.3f} | {1e3 * ss['aco2']:.3f} | {ratio:.1f}x ({best}) | {tw['eval']['cycle']:.1f} | "
                  f"{row['slicer']['eval']['cycle']:.1f} | {tw['wall']:.2f} ({tw['cpu']:.2f}) | {row['slicer']['wall']:.2f} |")
+    L.append("")
+    L.append(f"### Integration over seeds 1-{seeds}: medians (the solvers are randomised)")
+    L.append("")
+    L.append("Travel from the written poses (median, and the worst seed in brackets) and solver time (median, "
+             "milliseconds, summed over the pricing rounds). 'Best paper' is the paper solver with the lowest "
+             "median travel; the speed ratio is its median solver time over towpath's.")
+    L.append("")
+    L.append("| part | passes | towpath travel | GA | ACO1 | ACO2 | towpath ms | GA ms | ACO1 ms | ACO2 ms | best paper | travel towpath / best | best paper time / towpath |")
+    L.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for name, row in res.items():
+        if name.startswith("_") or "seeds" not in row:
+            continue
+        sd = row["seeds"]
+        med = {k: statistics.median(sd[k]["travel"]) for k in sd}
+        worst = {k: max(sd[k]["travel"]) for k in sd}
+        ms = {k: 1e3 * statistics.median(sd[k]["seconds"]) for k in sd}
+        best = min(("ga", "aco1", "aco2"), key=lambda k: (med[k], ms[k]))
+        cells = " | ".join(f"{med[k]:.1f} ({worst[k]:.1f})" for k in ("towpath", "ga", "aco1", "aco2"))
+        times = " | ".join(f"{ms[k]:.3f}" for k in ("towpath", "ga", "aco1", "aco2"))
+        L.append(f"| {name} | {row['towpath']['crate']['passes']} | {cells} | {times} | {best} | "
+                 f"{med['towpath'] / med[best]:.3f} | {ms[best] / ms['towpath']:.1f}x |")
     L.append("")
     if res.get("_speed"):
         L.append("### Speed: 200k triangles (partition, passes, sequencing, thickness map)")

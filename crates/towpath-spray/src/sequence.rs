@@ -21,7 +21,7 @@ use std::time::Duration;
 use glam::DVec3;
 use rayon::prelude::*;
 use towpath_baselines::{solve_with, BaselineParams, SolverName};
-use towpath_seq::{CostModel, End, Mode, Problem, SolveOptions, StateId, Step};
+use towpath_seq::{solve_reversible, CostModel, End, Mode, Problem, SolveOptions, StateId, Step};
 
 use crate::error::SprayError;
 use crate::passes::Pass;
@@ -30,10 +30,11 @@ use crate::transit::{Clearance, Transit};
 /// Most solve rounds of the lazy pricing.
 pub const MAX_ROUNDS: usize = 6;
 /// Default work budget per pass (improvement kicks of towpath's solver).
-pub const KICKS_PER_PASS: u64 = 100;
+pub const KICKS_PER_PASS: u64 = 15;
 /// Smallest default work budget.
-pub const MIN_KICKS: u64 = 2000;
-/// The solver stops when this many of its twenty epochs in a row found nothing better.
+pub const MIN_KICKS: u64 = 100;
+/// The solver stops when this many twentieths of its budget in a row found nothing better
+/// (and never before as many kicks again as the best route took to find).
 pub const STALL_EPOCHS: u32 = 3;
 /// Up to this many pairs of pass ends on different patches, every such transit is priced as
 /// written before the first solve (in parallel), so the solver sees the lifts from the start.
@@ -239,8 +240,12 @@ pub fn sequence(
             stall_epochs: Some(STALL_EPOCHS),
             ..SolveOptions::default()
         };
-        let report =
-            solve_with(opts.solver, &problem, &so, &opts.params).map_err(|e| SprayError::Sequencing(e.to_string()))?;
+        let report = match opts.solver {
+            SolverName::Towpath => {
+                solve_reversible(&problem, &so).map_err(|e| SprayError::Sequencing(e.to_string()))?
+            }
+            s => solve_with(s, &problem, &so, &opts.params).map_err(|e| SprayError::Sequencing(e.to_string()))?,
+        };
         solver_seconds += report.elapsed.as_secs_f64();
         let steps = report.solution.steps;
         // Price the route's transits as written.

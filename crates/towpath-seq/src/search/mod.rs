@@ -9,6 +9,7 @@ mod merge;
 mod modes;
 mod neighbors;
 mod net;
+mod reversible;
 mod sop3;
 mod tour;
 
@@ -47,6 +48,8 @@ use ils::{Budget, Ils};
 use neighbors::Neighbors;
 use net::Net;
 use tour::Tour;
+
+pub use reversible::{solve_reversible, MAX_REVERSIBLE_TASKS};
 
 /// Progress of a running solve, passed to [`SolveOptions::progress`].
 #[derive(Clone, Debug)]

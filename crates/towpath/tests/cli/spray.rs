@@ -132,6 +132,8 @@ fn box_mesh_gives_six_patches_and_the_papers_solvers_run() {
         travel.push(s["travel_mm"].as_f64().unwrap());
     }
     assert!(travel.iter().all(|&t| t > 0.0));
+    // towpath's search (100 kicks) is no longer than the paper's solvers on the same passes.
+    assert!(travel[0] <= travel[1].min(travel[2]) + 1e-6, "travel towpath, GA, ACO1: {travel:?}");
 }
 
 #[test]
