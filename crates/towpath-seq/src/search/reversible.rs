@@ -35,6 +35,9 @@
 
 use std::collections::VecDeque;
 
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
 use crate::clock::Clock;
 use crate::cost::{Cost, CostModel};
 use crate::model::{End, Problem, TaskId};
@@ -99,7 +102,7 @@ pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions)
         (Some(b), Some(k)) => Some((b / 20).max(1) * k as u64),
         _ => None,
     };
-    let mut rng = SplitMix(opts.seed ^ 0x0005_EED0_F5E6);
+    let mut rng = Pcg64Mcg::seed_from_u64(opts.seed);
     let mut kicks = 0u64;
     let mut since = 0u64;
     let mut trial = route.clone();
@@ -182,22 +185,6 @@ struct RunPair {
     way_a: u8,
     way_b: u8,
     b_first: bool,
-}
-
-/// Small deterministic random numbers (SplitMix64).
-struct SplitMix(u64);
-
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
 }
 
 /// A route: tasks by position (0-based), each task's direction (true: run backwards, mode 1),
@@ -726,16 +713,16 @@ impl Dense {
 
     /// A segment swap: two adjacent stretches at a random position exchange places, each
     /// turned round or not at random; the ends of the changed arcs are queued.
-    fn kick(&mut self, r: &mut Route, rng: &mut SplitMix) {
+    fn kick(&mut self, r: &mut Route, rng: &mut Pcg64Mcg) {
         let n = self.n;
-        let (a, b, c) = if rng.next() & 1 == 0 {
+        let (a, b, c) = if rng.gen::<bool>() {
             let most = KICK_SEGMENT.min(n / 2).max(1);
-            let l1 = 1 + rng.below(most);
-            let l2 = 1 + rng.below(most);
+            let l1 = 1 + rng.gen_range(0..most);
+            let l2 = 1 + rng.gen_range(0..most);
             if l1 + l2 > n {
                 return;
             }
-            let a = rng.below(n - l1 - l2 + 1);
+            let a = rng.gen_range(0..n - l1 - l2 + 1);
             (a, a + l1, a + l1 + l2)
         } else {
             // Cut at three of the route's dearest arcs (the route's end counts as one): whole
@@ -751,9 +738,9 @@ impl Dense {
             gaps.push((0.0, n as u32));
             let m = gaps.len();
             let mut cuts = [0usize; 3];
-            let i0 = rng.below(m);
-            let i1 = (i0 + 1 + rng.below(m - 1)) % m;
-            let mut i2 = rng.below(m - 2);
+            let i0 = rng.gen_range(0..m);
+            let i1 = (i0 + 1 + rng.gen_range(0..m - 1)) % m;
+            let mut i2 = rng.gen_range(0..m - 2);
             for lo in [i0.min(i1), i0.max(i1)] {
                 if i2 >= lo {
                     i2 += 1;
@@ -772,7 +759,7 @@ impl Dense {
             self.push(e);
             self.push(f);
         }
-        let turn = (rng.next() & 3) as u8;
+        let turn: u8 = rng.gen_range(0..4);
         let delta = self.swap_delta(r, a, b, c, turn);
         self.swap(r, a, b, c, turn, delta);
     }
@@ -884,7 +871,7 @@ mod tests {
         let p = segments(3, 60, true);
         let mut dense = Dense::new(&p).expect("finite costs");
         let mut r = dense.nearest_neighbour();
-        let mut rng = SplitMix(9);
+        let mut rng = Pcg64Mcg::seed_from_u64(9);
         for _ in 0..200 {
             dense.kick(&mut r, &mut rng);
             dense.drain(&mut r, 1e-9);
