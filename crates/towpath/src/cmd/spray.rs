@@ -79,7 +79,8 @@ pub struct Args {
     /// Seed for the solver's random choices.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Solver threads (default: all cores).
+    /// Sequencing threads (default: all cores): transit pricing, and the general solver on plans
+    /// of more than 1,500 passes; towpath's search for smaller plans runs on one.
     #[arg(long)]
     pub threads: Option<usize>,
     #[command(flatten)]
