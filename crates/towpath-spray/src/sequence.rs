@@ -241,11 +241,10 @@ pub fn sequence(
             ..SolveOptions::default()
         };
         let report = match opts.solver {
-            SolverName::Towpath => {
-                solve_reversible(&problem, &so).map_err(|e| SprayError::Sequencing(e.to_string()))?
-            }
-            s => solve_with(s, &problem, &so, &opts.params).map_err(|e| SprayError::Sequencing(e.to_string()))?,
-        };
+            SolverName::Towpath => solve_reversible(&problem, &so).map_err(|e| e.to_string()),
+            s => solve_with(s, &problem, &so, &opts.params).map_err(|e| e.to_string()),
+        }
+        .map_err(SprayError::Sequencing)?;
         solver_seconds += report.elapsed.as_secs_f64();
         let steps = report.solution.steps;
         // Price the route's transits as written.

@@ -259,7 +259,7 @@ impl Dense {
                 d[v * m + home] = c;
             }
         }
-        // Nearest ends of each end (not its own task's other end), home's too.
+        // Nearest ends of each end (not its own task's other end).
         let k = list_len(n);
         let mut nb = vec![0u32; 2 * n * k];
         let mut cand: Vec<(Cost, u32)> = Vec::with_capacity(2 * n);
@@ -456,7 +456,8 @@ impl Dense {
                 return true;
             }
         }
-        // Or-opt: a stretch with u at one of its ends moves next to a near end of either end.
+        // Or-opt: a stretch of one to three tasks beginning or ending with u's task moves next to
+        // a near end of either of its ends.
         for len in 1..=OR_SEGMENT.min(self.n - 1) {
             let starts = [Some(i), if len > 1 && i >= len { Some(i + 1 - len) } else { None }];
             for s in starts.into_iter().flatten() {
@@ -501,21 +502,31 @@ impl Dense {
             if self.arc(self.ex(r, i - 1), self.en(r, i)) <= long {
                 return None;
             }
-            let mut t = i;
-            while t < self.n && self.arc(self.ex(r, t), self.en(r, t + 1)) <= long {
-                t += 1;
-            }
-            Some((i, t))
+            Some((i, self.run_last(r, i)))
         } else {
             if i >= self.n || self.arc(self.ex(r, i), self.en(r, i + 1)) <= long {
                 return None;
             }
-            let mut s = i;
-            while s > 1 && self.arc(self.ex(r, s - 1), self.en(r, s)) <= long {
-                s -= 1;
-            }
-            Some((s, i))
+            Some((self.run_first(r, i), i))
         }
+    }
+
+    /// The first position of the run that position `i` (1-based) is in.
+    fn run_first(&self, r: &Route, i: usize) -> usize {
+        let mut s = i;
+        while s > 1 && self.arc(self.ex(r, s - 1), self.en(r, s)) <= self.long {
+            s -= 1;
+        }
+        s
+    }
+
+    /// The last position of the run that position `i` (1-based) is in.
+    fn run_last(&self, r: &Route, i: usize) -> usize {
+        let mut t = i;
+        while t < self.n && self.arc(self.ex(r, t), self.en(r, t + 1)) <= self.long {
+            t += 1;
+        }
+        t
     }
 
     /// The cost of the inner links of positions `s ..= t` (1-based) turned over, minus their
@@ -525,25 +536,12 @@ impl Dense {
     }
 
     /// The best rearrangement of the two runs meeting at long arc `gap` (one run when the gap
-    /// is at home or the tail): each run in one of four ways ([`RunWay`]), the pair in either
+    /// is at home or the tail): each run in one of four ways (see [`RunPair`]), the pair in either
     /// order.
     fn best_run_pair(&self, r: &Route, gap: usize, eps: Cost) -> Option<RunPair> {
-        let long = self.long;
         // Run A ends at `gap` (empty at home), run B starts after it (empty at the tail).
-        let mut sa = gap + 1;
-        if gap >= 1 {
-            sa = gap;
-            while sa > 1 && self.arc(self.ex(r, sa - 1), self.en(r, sa)) <= long {
-                sa -= 1;
-            }
-        }
-        let mut tb = gap;
-        if gap < self.n {
-            tb = gap + 1;
-            while tb < self.n && self.arc(self.ex(r, tb), self.en(r, tb + 1)) <= long {
-                tb += 1;
-            }
-        }
+        let sa = if gap >= 1 { self.run_first(r, gap) } else { gap + 1 };
+        let tb = if gap < self.n { self.run_last(r, gap + 1) } else { gap };
         let (p, f) = (self.ex(r, sa - 1), self.en(r, tb + 1));
         let now = self.arc(p, self.en(r, sa))
             + self.arc(self.ex(r, tb), f)
@@ -753,12 +751,6 @@ impl Dense {
             cuts.sort_unstable();
             (cuts[0], cuts[1], cuts[2])
         };
-        for i in [a, b, c] {
-            let e = self.ex(r, i);
-            let f = self.en(r, i + 1);
-            self.push(e);
-            self.push(f);
-        }
         let turn: u8 = rng.gen_range(0..4);
         let delta = self.swap_delta(r, a, b, c, turn);
         self.swap(r, a, b, c, turn, delta);
