@@ -64,21 +64,34 @@ pub struct Rules {
     pub start: Option<P2>,
 }
 
-fn seg_dist(p: P2, a: P2, b: P2) -> f64 {
+/// Squared distance from `p` to the segment `a`–`b` (no `hypot`, which guards against an
+/// overflow no drawing reaches and is many times slower).
+fn seg_dist2(p: P2, a: P2, b: P2) -> f64 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let l2 = dx * dx + dy * dy;
     let t = if l2 > 0.0 { (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
-    dist(p, [a[0] + t * dx, a[1] + t * dy])
+    let (ex, ey) = (p[0] - (a[0] + t * dx), p[1] - (a[1] + t * dy));
+    ex * ex + ey * ey
+}
+
+fn seg_dist(p: P2, a: P2, b: P2) -> f64 {
+    seg_dist2(p, a, b).sqrt()
+}
+
+/// Every `step`-th point of `a` (at most 256 of them, the last one too): the points of `a`
+/// whose distance to the other path is checked.
+fn samples(a: &[P2]) -> impl Iterator<Item = &P2> {
+    let step = a.len().div_ceil(256).max(1);
+    a.iter().step_by(step)
 }
 
 /// Largest distance from a sample of `a`'s points to the polyline `b`.
 fn one_sided(a: &[P2], b: &[P2]) -> f64 {
-    let step = a.len().div_ceil(256).max(1);
     let mut worst: f64 = 0.0;
-    for p in a.iter().step_by(step) {
+    for p in samples(a) {
         let mut best = f64::INFINITY;
         if b.len() == 1 {
-            best = dist(*p, b[0]);
+            best = seg_dist(*p, b[0], b[0]);
         }
         for w in b.windows(2) {
             best = best.min(seg_dist(*p, w[0], w[1]));
@@ -86,6 +99,32 @@ fn one_sided(a: &[P2], b: &[P2]) -> f64 {
         worst = worst.max(best);
     }
     worst
+}
+
+/// Whether `one_sided(a, b) <= eps`, found without pricing every segment: each sample needs
+/// only one segment of `b` within `eps`, and the search for it starts at the segment that held
+/// the previous sample and widens both ways (consecutive samples of the same geometry lie on
+/// nearby segments, whichever way and from wherever the path was drawn). O(samples) when the
+/// geometry is the same; `one_sided` then prices the failure.
+fn within(a: &[P2], b: &[P2], eps: f64) -> bool {
+    if b.len() == 1 {
+        return samples(a).all(|p| seg_dist(*p, b[0], b[0]) <= eps);
+    }
+    let m = b.len() - 1;
+    let mut hint = 0usize;
+    'points: for p in samples(a) {
+        for k in 0..m {
+            // hint, hint + 1, hint - 1, hint + 2, … around the polyline's segments
+            let off = k.div_ceil(2) % m;
+            let s = if k % 2 == 1 { (hint + off) % m } else { (hint + m - off) % m };
+            if seg_dist(*p, b[s], b[s + 1]) <= eps {
+                hint = s;
+                continue 'points;
+            }
+        }
+        return false;
+    }
+    true
 }
 
 fn same_geometry(orig: &Path, done: &Path, reversed: bool, may_reverse: bool, tol: f64) -> Result<(), String> {
@@ -100,8 +139,8 @@ fn same_geometry(orig: &Path, done: &Path, reversed: bool, may_reverse: bool, to
     }
     let fo = orig.flatten(tol);
     let fd = done.flatten(tol);
-    let h = one_sided(&fd, &fo).max(one_sided(&fo, &fd));
-    if h > eps {
+    if !within(&fd, &fo, eps) || !within(&fo, &fd, eps) {
+        let h = one_sided(&fd, &fo).max(one_sided(&fo, &fd));
         return Err(format!("lies up to {h:.3e} off the original"));
     }
     if orig.closed {
@@ -262,4 +301,47 @@ pub fn verify(drawing: &Drawing, done: &[Placement], rules: &Rules) -> Verificat
         }
     }
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A wavy closed polyline of `n` points.
+    fn loop_points(n: usize) -> Vec<P2> {
+        (0..=n)
+            .map(|i| {
+                let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
+                let r = 50.0 + 5.0 * (7.0 * a).sin();
+                [r * a.cos(), r * a.sin()]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn within_agrees_with_the_full_distance() {
+        let a = loop_points(700);
+        // the same loop reversed and started elsewhere
+        let mut b: Vec<P2> = a[..700].to_vec();
+        b.rotate_left(333);
+        b.reverse();
+        b.push(b[0]);
+        assert!(within(&a, &b, 1e-9) && within(&b, &a, 1e-9));
+        assert!(one_sided(&a, &b) <= 1e-9);
+        // moved by 0.3: within 0.5, not within 0.2, as the full scan says
+        let moved: Vec<P2> = b.iter().map(|p| [p[0] + 0.3, p[1]]).collect();
+        let h = one_sided(&a, &moved);
+        assert!(h > 0.2 && h <= 0.3 + 1e-9, "{h}");
+        for eps in [0.1, 0.2, 0.29, 0.31, 0.5] {
+            assert_eq!(within(&a, &moved, eps), h <= eps, "eps {eps}");
+        }
+        // one point of a far off: found however far from the hint
+        let mut bent = a.clone();
+        bent[402] = [0.0, 0.0]; // a sampled point (every third)
+        let h = one_sided(&bent, &a);
+        assert!(h > 10.0);
+        assert!(!within(&bent, &a, 1.0) && within(&bent, &a, h + 1e-9));
+        // a single point
+        assert!(within(&[[1.0, 1.0]], &[[1.0, 1.5]], 0.5) && !within(&[[1.0, 1.0]], &[[1.0, 1.5]], 0.4));
+    }
 }

@@ -108,7 +108,8 @@ pub struct Args {
     /// Flattening and "touching" tolerance in drawing units.
     #[arg(long, default_value_t = 1e-3)]
     pub tolerance: f64,
-    /// Solver time limit in seconds (default 0.2 ms per piece, at least 0.1 s and at most 5 s).
+    /// Solver time limit in seconds (default 0.2 ms per piece, at least 0.1 s and at most 5 s;
+    /// the search stops sooner when it stagnates).
     #[arg(long)]
     pub time_limit: Option<f64>,
     /// Work budget (improvement kicks); without --time-limit the answer then depends only on
