@@ -322,8 +322,22 @@ def run_vpype(inp, out, two_opt):
     return timed(cmd)[0]
 
 
+SOLVE = []  # towpath's reported solve seconds of the last towpath run
+
+
 def run_towpath(inp, out, extra):
-    return timed([str(TOWPATH), "order", str(inp), "-o", str(out), "--start", "none", "--json", *extra])[0]
+    dt, stdout = timed([str(TOWPATH), "order", str(inp), "-o", str(out), "--start", "none", "--json", *extra])
+    SOLVE.append(json.loads(stdout)["solve_seconds"])
+    return dt
+
+
+def tenth_of_two_opt(row):
+    """towpath's --time-limit for a whole run in 0.1x vpype 2-opt's median wall time: that time
+    less towpath's own reading/checking/writing (its default run's median wall minus solve
+    time), at least 1 ms."""
+    v2, t = row["vpype linesort --two-opt"], row["towpath order"]
+    overhead = statistics.median(w - s for w, s in zip(t["seconds"], t["solve"]))
+    return max(0.001, 0.1 * v2["seconds_median"] - overhead)
 
 
 def bench_cut(args, results):
@@ -354,8 +368,11 @@ def bench_cut(args, results):
                  ("towpath order --no-inner-first", lambda o: run_towpath(inp, o, ["--no-inner-first"]))]
         if n is None or n <= args.skip_vpype_2opt_above:
             tools.insert(1, ("vpype linesort --two-opt", lambda o: run_vpype(inp, o, True)))
+            tools.append(("towpath order, 0.1x 2-opt time",
+                          lambda o: run_towpath(inp, o, ["--time-limit", f"{tenth_of_two_opt(row):.4f}"])))
         for name, fn in tools:
             times, pens, cpus = [], [], []
+            SOLVE.clear()
             for r in range(args.runs):
                 out = OUT / f"{inp.stem}.{name.replace(' ', '_').replace('-', '')}.{r}.svg"
                 dt = fn(out)
@@ -369,6 +386,8 @@ def bench_cut(args, results):
                    "penup_median": statistics.median(pens), "seconds_median": statistics.median(times),
                    "cpu_median": statistics.median(cpus), "penups": pens, "seconds": times, "cpu": cpus,
                    "load": os.getloadavg()[0]}
+            if name.startswith("towpath"):
+                rec["solve"] = list(SOLVE)
             results.append(rec)
             print(json.dumps(rec), flush=True)
             row[name] = rec
@@ -377,8 +396,8 @@ def bench_cut(args, results):
 
 
 def cut_table(rows):
-    out = ["| drawing | strokes | as drawn | vpype greedy | vpype 2-opt | towpath | towpath, no inner-first | towpath / 2-opt pen-up | towpath / 2-opt wall time |",
-           "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    out = ["| drawing | strokes | as drawn | vpype greedy | vpype 2-opt | towpath | towpath, no inner-first | towpath / 2-opt pen-up | towpath / 2-opt wall time | towpath in 0.1x 2-opt's time | its pen-up / 2-opt | its wall time / 2-opt |",
+           "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         def cell(name):
             rec = r.get(name)
@@ -387,8 +406,12 @@ def cut_table(rows):
         t, v2 = r.get("towpath order"), r.get("vpype linesort --two-opt")
         ratio_p = f"{t['penup_median'] / v2['penup_median']:.3f}" if t and v2 else "–"
         ratio_t = f"{t['seconds_median'] / v2['seconds_median']:.3f}" if t and v2 else "–"
+        f = r.get("towpath order, 0.1x 2-opt time")
+        fast_p = f"{f['penup_median'] / v2['penup_median']:.3f}" if f and v2 else "–"
+        fast_t = f"{f['seconds_median'] / v2['seconds_median']:.3f}" if f and v2 else "–"
         out.append(f"| {r['case']} | {r['strokes']:,} | {r['input_penup']:,.0f} mm | {cell('vpype linesort')} | {cell('vpype linesort --two-opt')} | "
-                   f"{cell('towpath order')} | {cell('towpath order --no-inner-first')} | {ratio_p} | {ratio_t} |")
+                   f"{cell('towpath order')} | {cell('towpath order --no-inner-first')} | {ratio_p} | {ratio_t} | "
+                   f"{cell('towpath order, 0.1x 2-opt time') if f else 'not run'} | {fast_p} | {fast_t} |")
     return "\n".join(out)
 
 

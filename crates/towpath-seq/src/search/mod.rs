@@ -138,7 +138,8 @@ pub struct SolveReport {
     pub iterations: u64,
     /// Wall time.
     pub elapsed: Duration,
-    /// True if the exact solver was used (the answer is optimal).
+    /// True when the answer is proven optimal: the exact solver was used, or (in
+    /// [`solve_reversible`]) the route met a lower bound.
     pub exact: bool,
 }
 

@@ -32,6 +32,8 @@
 //! undone when the route got dearer (Martin, Otto & Felten 1991; Lourenço, Martin & Stützle
 //! 2003). Deterministic under a work budget; single-threaded. Up to [`FULL_LISTS_UP_TO`] tasks
 //! every end's neighbour list holds every other end (the gain criterion ends each scan early).
+//! Up to [`BOUND_UP_TO`] tasks the search stops as soon as its route costs no more than a
+//! minimum spanning tree over the tasks (a lower bound; often met by a single patch's raster).
 
 use std::collections::VecDeque;
 
@@ -56,6 +58,9 @@ const NEIGHBOURS: usize = 10;
 const FULL_LISTS_UP_TO: usize = 200;
 /// Longest stretch an Or-opt move moves.
 const OR_SEGMENT: usize = 3;
+/// Up to this many tasks the search prices the spanning-tree lower bound ([`Dense::tree_bound`])
+/// and stops as soon as a route meets it (proven optimal).
+const BOUND_UP_TO: usize = 200;
 /// An arc longer than this many times the mean distance from an end to its nearest other end
 /// ends a run of tasks (Or-opt moves whole runs).
 const LONG_ARC: f64 = 2.5;
@@ -72,7 +77,9 @@ const CLOCK_EVERY: u64 = 32;
 /// Honours the time limit, the work budget (`iterations` kicks), `stall_epochs` (stop after
 /// that many twentieths of the budget in a row without an improvement, but never before as
 /// many kicks again as it took to find the best route), the seed, the cancel flag and the
-/// initial route (the answer is never worse). Runs on one thread whatever `threads` says.
+/// initial route (the answer is never worse). Up to [`BOUND_UP_TO`] tasks it stops as soon as
+/// the route meets a lower bound ([`Dense::tree_bound`]), and reports it `exact` (proven
+/// optimal). Runs on one thread whatever `threads` says.
 pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<SolveReport, SolveError> {
     if opts.threads > super::MAX_THREADS {
         return Err(SolveError::TooManyThreads { threads: opts.threads });
@@ -97,6 +104,9 @@ pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions)
         }
     }
     let first_local_optimum = route.cost;
+    let bound = search.tree_bound();
+    let tol = 1e-9 * search.typical.max(Cost::MIN_POSITIVE) * search.n as f64;
+    let proven = |c: Cost| bound.is_some_and(|b| c <= b + tol);
     let budget = opts.iterations;
     let stall = match (budget, opts.stall_epochs) {
         (Some(b), Some(k)) => Some((b / 20).max(1) * k as u64),
@@ -108,7 +118,11 @@ pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions)
     let mut trial = route.clone();
     // The kick that found the best route so far: the stall rule waits at least as long again.
     let mut found_at = 0u64;
-    while search.n >= 4 && budget.is_none_or(|b| kicks < b) && stall.is_none_or(|s| since < s.max(found_at)) {
+    while search.n >= 4
+        && !proven(route.cost)
+        && budget.is_none_or(|b| kicks < b)
+        && stall.is_none_or(|s| since < s.max(found_at))
+    {
         if kicks % CLOCK_EVERY == 0 && (clock.expired() || (budget.is_none() && clock.deadline().is_none())) {
             break;
         }
@@ -128,20 +142,14 @@ pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions)
     let steps: Vec<Step> =
         route.seq.iter().map(|&t| Step { task: TaskId(t), mode: u32::from(route.dir[t as usize]) }).collect();
     let cost = check(problem, &steps).map_err(SolveError::NoFeasibleRoute)?;
+    let exact = proven(route.cost);
     let mut solution = Solution { steps, cost };
     if let (Some(init), Some(ic)) = (&opts.initial, initial_cost) {
         if ic < solution.cost {
             solution = Solution { steps: init.clone(), cost: ic };
         }
     }
-    Ok(SolveReport {
-        solution,
-        initial_cost,
-        first_local_optimum,
-        iterations: kicks,
-        elapsed: t0.elapsed(),
-        exact: false,
-    })
+    Ok(SolveReport { solution, initial_cost, first_local_optimum, iterations: kicks, elapsed: t0.elapsed(), exact })
 }
 
 /// True when the problem is an open route over reversible segments the dense search takes.
@@ -162,6 +170,16 @@ fn applies<C: CostModel>(problem: &Problem<C>) -> bool {
         [a, b] => a.entry == b.exit && a.exit == b.entry && a.cost == b.cost && a.cost.is_finite(),
         _ => false,
     })
+}
+
+/// An integer key in the order of [`f64::total_cmp`].
+fn order_key(c: Cost) -> u64 {
+    let b = c.to_bits();
+    if b >> 63 == 1 {
+        !b
+    } else {
+        b | (1 << 63)
+    }
 }
 
 /// Length of each end's neighbour list.
@@ -214,6 +232,8 @@ struct Dense {
     m: usize,
     d: Vec<Cost>,
     nb: Vec<u32>,
+    /// The route starts at a home state (else the home sentinel's arcs cost nothing).
+    has_home: bool,
     typical: Cost,
     /// Arcs dearer than this end a run (see [`LONG_ARC`]).
     long: Cost,
@@ -265,7 +285,27 @@ impl Dense {
         let mut cand: Vec<(Cost, u32)> = Vec::with_capacity(2 * n);
         let mut sum = 0.0;
         let mut count = 0usize;
+        let mut keys: Vec<u128> = Vec::with_capacity(2 * n);
         for u in 0..2 * n {
+            if k == 2 * n - 2 {
+                // Every other end, by cost then number (the order a stable sort by cost gives),
+                // sorted as integers: several times faster than comparing floats on small plans.
+                keys.clear();
+                keys.extend(
+                    (0..2 * n)
+                        .filter(|&v| v != u && v != (u ^ 1))
+                        .map(|v| (u128::from(order_key(d[u * m + v])) << 32) | v as u128),
+                );
+                keys.sort_unstable();
+                if let Some(&first) = keys.first() {
+                    sum += d[u * m + (first as u32) as usize];
+                    count += 1;
+                }
+                for (i, &key) in keys.iter().enumerate() {
+                    nb[u * k + i] = key as u32;
+                }
+                continue;
+            }
             cand.clear();
             cand.extend((0..2 * n).filter(|&v| v != u && v != (u ^ 1)).map(|v| (d[u * m + v], v as u32)));
             if k > 0 && cand.len() > k {
@@ -287,6 +327,7 @@ impl Dense {
             m,
             d,
             nb,
+            has_home: problem.start().is_some(),
             typical,
             long: LONG_ARC * typical,
             queue: VecDeque::new(),
@@ -342,6 +383,52 @@ impl Dense {
 
     fn cost_of(&self, r: &Route) -> Cost {
         (0..=self.n).map(|i| self.arc(self.ex(r, i), self.en(r, i + 1))).sum()
+    }
+
+    /// A lower bound on every route's transit cost, up to [`BOUND_UP_TO`] tasks: a route is a
+    /// path through home (if any) and every task, so a spanning tree over them, and none is
+    /// cheaper than the minimum spanning tree whose edge between two tasks costs the cheapest
+    /// arc between their ends (Prim's algorithm, O(n²)). A single patch's raster, whose turns
+    /// join each pass to its nearest neighbour's near end, meets it: the search can stop there.
+    /// (Held–Karp penalties on the tree's degrees, tried on the four-patch cylinder section of
+    /// the spray benchmark, raised its bound only from 0.20 % to 0.17 % under the optimum in
+    /// 40 steps: not worth their time on plans this small.)
+    fn tree_bound(&self) -> Option<Cost> {
+        let n = self.n;
+        if n > BOUND_UP_TO {
+            return None;
+        }
+        let home = 2 * n as u32;
+        let edge = |a: usize, b: usize| -> Cost {
+            if a == n || b == n {
+                let t = 2 * (a + b - n) as u32;
+                return self.arc(home, t).min(self.arc(home, t + 1));
+            }
+            let (x, y) = (2 * a as u32, 2 * b as u32);
+            self.arc(x, y).min(self.arc(x, y + 1)).min(self.arc(x + 1, y)).min(self.arc(x + 1, y + 1))
+        };
+        // node n is home, when there is one
+        let nodes = n + usize::from(self.has_home);
+        let mut dist = vec![Cost::INFINITY; nodes];
+        let mut done = vec![false; nodes];
+        dist[0] = 0.0;
+        let mut total = 0.0;
+        for _ in 0..nodes {
+            let mut u = usize::MAX;
+            for v in 0..nodes {
+                if !done[v] && (u == usize::MAX || dist[v] < dist[u]) {
+                    u = v;
+                }
+            }
+            done[u] = true;
+            total += dist[u];
+            for v in 0..nodes {
+                if !done[v] {
+                    dist[v] = dist[v].min(edge(u, v));
+                }
+            }
+        }
+        Some(total)
     }
 
     fn nearest_neighbour(&self) -> Route {
@@ -920,6 +1007,36 @@ mod tests {
         let opt = check(&p, &optimum.steps).expect("feasible") - 2.0 * k as f64 * 100.0;
         assert!(r.cost < before - 50.0, "{before} -> {}", r.cost);
         assert!(r.cost <= opt + 1e-6, "{} vs optimum {opt}", r.cost);
+    }
+
+    #[test]
+    fn the_tree_bound_is_below_every_optimum_and_proves_rasters_optimal() {
+        for seed in 0..40 {
+            for home in [false, true] {
+                let p = segments(seed, 8, home);
+                let exact = solve_exact(&p).expect("exact runs").expect("an optimum");
+                // the transit part of the optimum (every task costs 3)
+                let opt = check(&p, &exact.steps).expect("feasible") - 8.0 * 3.0;
+                let bound = Dense::new(&p).expect("finite costs").tree_bound().expect("small");
+                assert!(bound <= opt + 1e-9, "seed {seed} home {home}: bound {bound} above the optimum {opt}");
+                let r = solve_reversible(&p, &opts(400)).expect("solves");
+                if r.exact {
+                    assert!((r.solution.cost - 24.0 - opt).abs() < 1e-6, "seed {seed}: proven but not optimal");
+                }
+            }
+        }
+        // Two rasters far apart: the zigzag through both is a spanning tree of nearest ends.
+        for k in [3, 4, 6] {
+            let p = two_rasters(k);
+            let r = solve_reversible(&p, &opts(5000)).expect("solves");
+            let optimum = solve_exact(&p).ok().flatten();
+            assert!(r.exact, "k {k}: not proven");
+            assert!(r.iterations < 5000, "k {k}: the bound did not stop the search");
+            if let Some(o) = optimum {
+                let opt = check(&p, &o.steps).expect("feasible");
+                assert!((r.solution.cost - opt).abs() < 1e-6, "k {k}: {} vs {opt}", r.solution.cost);
+            }
+        }
     }
 
     #[test]
