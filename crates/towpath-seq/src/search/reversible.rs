@@ -94,19 +94,23 @@ pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions)
         None => None,
     };
     let eps = 1e-9 * search.typical.max(Cost::MIN_POSITIVE);
-    let mut route = search.nearest_neighbour();
-    search.descend(&mut route, eps);
-    if let Some(steps) = &opts.initial {
-        let mut from = search.route_from_steps(steps);
-        search.descend(&mut from, eps);
-        if from.cost < route.cost - eps {
-            route = from;
-        }
-    }
-    let first_local_optimum = route.cost;
     let bound = search.tree_bound();
     let tol = 1e-9 * search.typical.max(Cost::MIN_POSITIVE) * search.n as f64;
     let proven = |c: Cost| bound.is_some_and(|b| c <= b + tol);
+    // A route that meets the bound needs no descent (a raster's nearest-neighbour route often
+    // does).
+    let mut route = search.nearest_neighbour();
+    if !proven(route.cost) {
+        search.descend(&mut route, eps);
+        if let Some(steps) = &opts.initial {
+            let mut from = search.route_from_steps(steps);
+            search.descend(&mut from, eps);
+            if from.cost < route.cost - eps {
+                route = from;
+            }
+        }
+    }
+    let first_local_optimum = route.cost;
     let budget = opts.iterations;
     let stall = match (budget, opts.stall_epochs) {
         (Some(b), Some(k)) => Some((b / 20).max(1) * k as u64),
@@ -279,12 +283,39 @@ impl Dense {
                 d[v * m + home] = c;
             }
         }
-        // Nearest ends of each end (not its own task's other end).
-        let k = list_len(n);
-        let mut nb = vec![0u32; 2 * n * k];
-        let mut cand: Vec<(Cost, u32)> = Vec::with_capacity(2 * n);
+        // Mean distance from an end to its nearest other end (not its own task's other end).
         let mut sum = 0.0;
         let mut count = 0usize;
+        for u in 0..2 * n {
+            let near = (0..2 * n).filter(|&v| v != u && v != (u ^ 1)).map(|v| d[u * m + v]).reduce(Cost::min);
+            if let Some(c) = near {
+                sum += c;
+                count += 1;
+            }
+        }
+        let typical = if count > 0 { sum / count as f64 } else { 1.0 };
+        Some(Dense {
+            n,
+            m,
+            d,
+            nb: Vec::new(),
+            has_home: problem.start().is_some(),
+            typical,
+            long: LONG_ARC * typical,
+            queue: VecDeque::new(),
+            queued: vec![false; 2 * n + 2],
+            gaps: Vec::new(),
+        })
+    }
+
+    /// Each end's nearest ends (not its own task's other end), nearest first; built when the
+    /// local search first needs them (a route proven optimal before that never does).
+    fn build_lists(&mut self) {
+        let n = self.n;
+        let k = list_len(n);
+        let mut nb = vec![0u32; 2 * n * k];
+        let (d, m) = (&self.d, self.m);
+        let mut cand: Vec<(Cost, u32)> = Vec::with_capacity(2 * n);
         let mut keys: Vec<u128> = Vec::with_capacity(2 * n);
         for u in 0..2 * n {
             if k == 2 * n - 2 {
@@ -297,10 +328,6 @@ impl Dense {
                         .map(|v| (u128::from(order_key(d[u * m + v])) << 32) | v as u128),
                 );
                 keys.sort_unstable();
-                if let Some(&first) = keys.first() {
-                    sum += d[u * m + (first as u32) as usize];
-                    count += 1;
-                }
                 for (i, &key) in keys.iter().enumerate() {
                     nb[u * k + i] = key as u32;
                 }
@@ -313,27 +340,11 @@ impl Dense {
             }
             cand.truncate(k);
             cand.sort_by(|a, b| a.0.total_cmp(&b.0));
-            if let Some(&(c, _)) = cand.first() {
-                sum += c;
-                count += 1;
-            }
             for (i, &(_, v)) in cand.iter().enumerate() {
                 nb[u * k + i] = v;
             }
         }
-        let typical = if count > 0 { sum / count as f64 } else { 1.0 };
-        Some(Dense {
-            n,
-            m,
-            d,
-            nb,
-            has_home: problem.start().is_some(),
-            typical,
-            long: LONG_ARC * typical,
-            queue: VecDeque::new(),
-            queued: vec![false; 2 * n + 2],
-            gaps: Vec::new(),
-        })
+        self.nb = nb;
     }
 
     #[inline]
@@ -495,6 +506,9 @@ impl Dense {
     }
 
     fn drain(&mut self, r: &mut Route, eps: Cost) {
+        if self.nb.is_empty() {
+            self.build_lists();
+        }
         while let Some(u) = self.queue.pop_front() {
             self.queued[u as usize] = false;
             while self.improve(r, u, eps) {}
