@@ -459,7 +459,7 @@ def bench_mill(args, results):
     for k in (8, 16, 32):
         p = OUT / f"part-{k}.json"
         p.write_text(json.dumps(seed003_part(k, k)))
-        row = {"part": p.stem}
+        row = {"part": f"{p.stem} ({k} pockets)"}
         for solver in ("towpath", "castelino"):
             times, after = [], []
             for _ in range(args.runs):
@@ -493,6 +493,7 @@ def main():
     ap.add_argument("--sizes", default="1000,10000,100000")
     ap.add_argument("--skip-vpype-2opt-above", type=int, default=10000)
     ap.add_argument("--no-mill", action="store_true")
+    ap.add_argument("--no-cut", action="store_true", help="only the machining table")
     ap.add_argument("--write-markdown", action="store_true")
     args = ap.parse_args()
     args.sizes = [int(s) for s in args.sizes.split(",") if s]
@@ -500,8 +501,9 @@ def main():
     if not TOWPATH.exists():
         subprocess.check_call(["cargo", "build", "--release", "-p", "towpath"], cwd=ROOT)
     results = []
-    cut = cut_table(bench_cut(args, results))
-    print(cut)
+    cut = None if args.no_cut else cut_table(bench_cut(args, results))
+    if cut:
+        print(cut)
     mill = None if args.no_mill else bench_mill(args, results)
     if mill:
         print(mill)
@@ -511,7 +513,8 @@ def main():
     if args.write_markdown:
         md = ROOT / "BENCHMARKS.md"
         text = md.read_text()
-        text = replace_between(text, "<!-- cut-bench:start -->", "<!-- cut-bench:end -->", cut)
+        if cut:
+            text = replace_between(text, "<!-- cut-bench:start -->", "<!-- cut-bench:end -->", cut)
         if mill:
             text = replace_between(text, "<!-- mill-bench:start -->", "<!-- mill-bench:end -->", mill)
         md.write_text(text)
