@@ -49,7 +49,7 @@ const OR_SEGMENT: usize = 3;
 /// once, each tried for 2n + 50 kicks) have gone by without an improvement: a small drawing is
 /// then done in milliseconds instead of waiting for its time limit (the 24 isolines of the
 /// benchmark's contour map found their answer within 80 kicks and stop after about 470).
-const STALL_CYCLES: u64 = 1;
+pub const STALL_CYCLES: u64 = 1;
 
 /// What the search may spend.
 #[derive(Clone, Copy, Debug, Default)]

@@ -77,9 +77,10 @@ const CLOCK_EVERY: u64 = 32;
 /// Honours the time limit, the work budget (`iterations` kicks), `stall_epochs` (stop after
 /// that many twentieths of the budget in a row without an improvement, but never before as
 /// many kicks again as it took to find the best route), the seed, the cancel flag and the
-/// initial route (the answer is never worse). Up to [`BOUND_UP_TO`] tasks it stops as soon as
-/// the route meets a lower bound ([`Dense::tree_bound`]), and reports it `exact` (proven
-/// optimal). Runs on one thread whatever `threads` says.
+/// initial route (the answer is never worse). Up to 200 tasks it stops as soon as the route
+/// meets a lower bound (the minimum spanning tree over the tasks, each pair joined by their
+/// nearest ends), and reports it `exact` (proven optimal). Runs on one thread whatever
+/// `threads` says.
 pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<SolveReport, SolveError> {
     if opts.threads > super::MAX_THREADS {
         return Err(SolveError::TooManyThreads { threads: opts.threads });
