@@ -11,7 +11,7 @@
 
 use rstar::{RTree, RTreeObject, AABB};
 
-use crate::geom::{bbox_of, signed_area, BBox, P2};
+use crate::geom::{bbox_of, seg_dist2, signed_area, BBox, P2};
 use crate::model::Drawing;
 
 /// At most this many points of a piece are tested against a contour around it.
@@ -26,14 +26,6 @@ pub enum Side {
     On,
     /// Strictly outside.
     Outside,
-}
-
-fn seg_dist2(p: P2, a: P2, b: P2) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let l2 = dx * dx + dy * dy;
-    let t = if l2 > 0.0 { (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
-    let (qx, qy) = (a[0] + t * dx - p[0], a[1] + t * dy - p[1]);
-    qx * qx + qy * qy
 }
 
 /// Point in polygon by crossing number, with the boundary (within `tol`) reported as `On`.

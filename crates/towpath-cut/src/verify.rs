@@ -6,7 +6,7 @@
 //! own containment test (winding number over every flattened vertex of the inner piece) rather
 //! than the optimizer's.
 
-use crate::geom::{bbox_of, dist, signed_area, Path, P2};
+use crate::geom::{bbox_of, dist, seg_dist2, signed_area, Path, P2};
 use crate::model::{travel, Drawing, Placement};
 
 /// What the verifier found.
@@ -62,16 +62,6 @@ pub struct Rules {
     pub tolerance: f64,
     /// Where the tool starts.
     pub start: Option<P2>,
-}
-
-/// Squared distance from `p` to the segment `a`–`b` (no `hypot`, which guards against an
-/// overflow no drawing reaches and is many times slower).
-fn seg_dist2(p: P2, a: P2, b: P2) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let l2 = dx * dx + dy * dy;
-    let t = if l2 > 0.0 { (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
-    let (ex, ey) = (p[0] - (a[0] + t * dx), p[1] - (a[1] + t * dy));
-    ex * ex + ey * ey
 }
 
 fn seg_dist(p: P2, a: P2, b: P2) -> f64 {
