@@ -12,6 +12,7 @@ mod net;
 mod reversible;
 mod sop3;
 mod tour;
+mod tree_proof;
 
 /// Test problems shared by the search modules' tests.
 #[cfg(test)]

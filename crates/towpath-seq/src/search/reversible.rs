@@ -34,6 +34,9 @@
 //! every end's neighbour list holds every other end (the gain criterion ends each scan early).
 //! Up to [`BOUND_UP_TO`] tasks the search stops as soon as its route costs no more than a
 //! minimum spanning tree over the tasks (a lower bound; often met by a single patch's raster).
+//! Up to [`PROOF_UP_TO`] tasks a branch and bound over such trees ([`super::tree_proof`]) is
+//! tried before the local search: on a few patches' rasters it usually finds the optimum and
+//! proves it in about one tree per task.
 
 use std::collections::VecDeque;
 
@@ -45,6 +48,7 @@ use crate::cost::{Cost, CostModel};
 use crate::model::{End, Problem, TaskId};
 use crate::solution::{check, Solution, Step};
 
+use super::tree_proof::Trees;
 use super::{solve, SolveError, SolveOptions, SolveReport};
 
 /// Largest problem [`solve_reversible`] takes (a dense matrix over twice as many ends); larger
@@ -61,6 +65,12 @@ const OR_SEGMENT: usize = 3;
 /// Up to this many tasks the search prices the spanning-tree lower bound ([`Dense::tree_bound`])
 /// and stops as soon as a route meets it (proven optimal).
 const BOUND_UP_TO: usize = 200;
+/// Largest plan the tree branch and bound ([`super::tree_proof`]) tries to solve exactly.
+const PROOF_UP_TO: usize = 40;
+/// It gives up when its first route is more than this fraction above its first tree.
+const PROOF_GAP: f64 = 0.02;
+/// Trees it may price, per task.
+const PROOF_NODES_PER_TASK: usize = 2;
 /// An arc longer than this many times the mean distance from an end to its nearest other end
 /// ends a run of tasks (Or-opt moves whole runs).
 const LONG_ARC: f64 = 2.5;
@@ -79,8 +89,9 @@ const CLOCK_EVERY: u64 = 32;
 /// many kicks again as it took to find the best route), the seed, the cancel flag and the
 /// initial route (the answer is never worse). Up to 200 tasks it stops as soon as the route
 /// meets a lower bound (the minimum spanning tree over the tasks, each pair joined by their
-/// nearest ends), and reports it `exact` (proven optimal). Runs on one thread whatever
-/// `threads` says.
+/// nearest ends), and reports it `exact` (proven optimal); up to 40 tasks a branch and bound
+/// over such trees first tries to find and prove the optimum within about two trees per task.
+/// Runs on one thread whatever `threads` says.
 pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<SolveReport, SolveError> {
     if opts.threads > super::MAX_THREADS {
         return Err(SolveError::TooManyThreads { threads: opts.threads });
@@ -99,9 +110,23 @@ pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions)
     let tol = 1e-9 * search.typical.max(Cost::MIN_POSITIVE) * search.n as f64;
     let proven = |c: Cost| bound.is_some_and(|b| c <= b + tol);
     // A route that meets the bound needs no descent (a raster's nearest-neighbour route often
-    // does).
+    // does). A small plan is then given to the tree branch and bound, which settles most plans of
+    // a few patches' rasters in about one tree per task, for less than the descent and the kicks
+    // would take; it gives up at once when its first route is far from its first tree.
     let mut route = search.nearest_neighbour();
-    if !proven(route.cost) {
+    let mut settled = false;
+    if bound.is_some() && search.n <= PROOF_UP_TO && !proven(route.cost) {
+        let trees = Trees::new(&search.d, search.m, search.n, search.has_home);
+        let proof = trees.prove(route.cost, tol, PROOF_GAP, PROOF_NODES_PER_TASK * search.n);
+        if let Some((seq, dir)) = proof.better {
+            let better = search.route(seq, dir);
+            if better.cost < route.cost {
+                route = better;
+            }
+        }
+        settled = proof.proven;
+    }
+    if !settled && !proven(route.cost) {
         search.descend(&mut route, eps);
         if let Some(steps) = &opts.initial {
             let mut from = search.route_from_steps(steps);
@@ -124,6 +149,7 @@ pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions)
     // The kick that found the best route so far: the stall rule waits at least as long again.
     let mut found_at = 0u64;
     while search.n >= 4
+        && !settled
         && !proven(route.cost)
         && budget.is_none_or(|b| kicks < b)
         && stall.is_none_or(|s| since < s.max(found_at))
@@ -147,7 +173,7 @@ pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions)
     let steps: Vec<Step> =
         route.seq.iter().map(|&t| Step { task: TaskId(t), mode: u32::from(route.dir[t as usize]) }).collect();
     let cost = check(problem, &steps).map_err(SolveError::NoFeasibleRoute)?;
-    let exact = proven(route.cost);
+    let exact = settled || proven(route.cost);
     let mut solution = Solution { steps, cost };
     if let (Some(init), Some(ic)) = (&opts.initial, initial_cost) {
         if ic < solution.cost {
@@ -1052,6 +1078,43 @@ mod tests {
                 assert!((r.solution.cost - opt).abs() < 1e-6, "k {k}: {} vs {opt}", r.solution.cost);
             }
         }
+    }
+
+    #[test]
+    fn patches_whose_zigzags_leave_by_the_far_end_are_solved_by_the_tree_branch_and_bound() {
+        // Four patches of 6, 6, 4 and 4 slightly tilted passes, in a row; in the first patch
+        // passes 3 and 4 are closer at their top ends, where no zigzag from the left can join
+        // them: the spanning tree is below every route, and only the branch and bound proves the
+        // route optimal.
+        let mut pts = Vec::new();
+        let mut x0 = 0.0;
+        for (patch, passes) in [6, 6, 4, 4].into_iter().enumerate() {
+            for i in 0..passes {
+                let x = x0 + 60.0 * i as f64;
+                let top = if patch == 0 && i == 4 { x - 10.0 } else { x + 2.0 };
+                pts.push([x, 0.0, 0.0]);
+                pts.push([top, 700.0, 0.0]);
+            }
+            x0 += 60.0 * passes as f64 + 40.0;
+        }
+        pts.push([-100.0, -50.0, 0.0]);
+        let n = 20;
+        let mut b = Problem::builder(PointCost::new(pts, Metric::Euclidean));
+        for t in 0..n as u32 {
+            let (s, e) = (StateId(2 * t), StateId(2 * t + 1));
+            b.task(vec![Mode { entry: s, exit: e, cost: 700.0 }, Mode { entry: e, exit: s, cost: 700.0 }]);
+        }
+        b.start(StateId(2 * n as u32));
+        b.end(End::Free);
+        let p = b.build().expect("valid problem");
+        let r = solve_reversible(&p, &opts(5000)).expect("solves");
+        assert!(r.exact, "not proven");
+        assert_eq!(r.iterations, 0, "proven before any kick");
+        let transit = r.solution.cost - 700.0 * n as f64;
+        let bound = Dense::new(&p).expect("finite costs").tree_bound().expect("small");
+        assert!(bound < transit - 1.0, "the tree bound alone ({bound}) already proves {transit}");
+        let general = solve(&p, &opts(20_000)).expect("solves");
+        assert!(r.solution.cost <= general.solution.cost + 1e-6, "{} vs {}", r.solution.cost, general.solution.cost);
     }
 
     #[test]
