@@ -66,6 +66,23 @@ pub(crate) fn nearest_neighbor<C: CostModel>(
     Some((seq, mode))
 }
 
+/// The tour that takes the tasks in the order of `pos` (a position per node), each as soon as
+/// precedence and consecutive groups let it: of the tasks that may come next, the one earliest
+/// in that order (a stable topological order). Every task keeps its mode 0.
+pub(crate) fn follow_order<C: CostModel>(net: &Net<C>, pos: &[u32]) -> Option<Seq> {
+    let mut b = Builder::new(net);
+    if net.depot != u32::MAX {
+        b.seq.push(net.depot);
+    }
+    while b.seq.len() < net.n {
+        let next = b.avail.iter().copied().filter(|&u| b.allowed(u)).min_by_key(|&u| (pos[u as usize], u))?;
+        b.take(next, 0);
+    }
+    let mut seq = b.seq;
+    rotate_to_anchor(net, &mut seq);
+    Some((seq, b.mode))
+}
+
 /// Bookkeeping for constructions that add tasks one at a time while keeping precedence and
 /// consecutive groups.
 struct Builder<'a, 'p, C> {

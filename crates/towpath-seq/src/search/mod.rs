@@ -9,6 +9,7 @@ mod merge;
 mod modes;
 mod neighbors;
 mod net;
+mod patching;
 mod reversible;
 mod sop3;
 mod tour;
@@ -268,6 +269,14 @@ fn construct_starts<C: CostModel>(
     }
     let pool =
         if net.depot != u32::MAX && problem.start().is_some() { vec![0] } else { construct::seed_pool(net, pool_size) };
+    // On asymmetric one-mode problems, the patched assignment (see `patching`) when its O(n³)
+    // fits in a twentieth of the time limit.
+    let affordable = opts.time_limit.is_none_or(|tl| (net.n as f64).powi(3) * 1e-9 <= tl.as_secs_f64() / 20.0);
+    if affordable {
+        if let Some((seq, mode)) = patching::assignment_patching(net, deadline) {
+            starts.push(Tour::new(net, seq, mode));
+        }
+    }
     let have_initial = opts.initial.is_some();
     for f in pool {
         let limit = if starts.is_empty() && !have_initial { None } else { deadline };
