@@ -62,7 +62,7 @@ const NEIGHBOURS: usize = 10;
 const FULL_LISTS_UP_TO: usize = 200;
 /// Longest stretch an Or-opt move moves.
 const OR_SEGMENT: usize = 3;
-/// Up to this many tasks the search prices the spanning-tree lower bound ([`Dense::tree_bound`])
+/// Up to this many tasks the search prices the spanning-tree lower bound ([`Dense::trees`])
 /// and stops as soon as a route meets it (proven optimal).
 const BOUND_UP_TO: usize = 200;
 /// Largest plan the tree branch and bound ([`super::tree_proof`]) tries to solve exactly.
@@ -106,26 +106,28 @@ pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions)
         None => None,
     };
     let eps = 1e-9 * search.typical.max(Cost::MIN_POSITIVE);
-    let bound = search.tree_bound();
     let tol = 1e-9 * search.typical.max(Cost::MIN_POSITIVE) * search.n as f64;
-    let proven = |c: Cost| bound.is_some_and(|b| c <= b + tol);
     // A route that meets the bound needs no descent (a raster's nearest-neighbour route often
     // does). A small plan is then given to the tree branch and bound, which settles most plans of
     // a few patches' rasters in about one tree per task, for less than the descent and the kicks
     // would take; it gives up at once when its first route is far from its first tree.
     let mut route = search.nearest_neighbour();
     let mut settled = false;
-    if bound.is_some() && search.n <= PROOF_UP_TO && !proven(route.cost) {
-        let trees = Trees::new(&search.d, search.m, search.n, search.has_home);
-        let proof = trees.prove(route.cost, tol, PROOF_GAP, PROOF_NODES_PER_TASK * search.n);
-        if let Some((seq, dir)) = proof.better {
-            let better = search.route(seq, dir);
-            if better.cost < route.cost {
-                route = better;
+    let bound = search.trees().map(|trees| {
+        let b = trees.bound();
+        if search.n <= PROOF_UP_TO && route.cost > b + tol {
+            let proof = trees.prove(route.cost, tol, PROOF_GAP, PROOF_NODES_PER_TASK * search.n);
+            if let Some((seq, dir)) = proof.better {
+                let better = search.route(seq, dir);
+                if better.cost < route.cost {
+                    route = better;
+                }
             }
+            settled = proof.proven;
         }
-        settled = proof.proven;
-    }
+        b
+    });
+    let proven = |c: Cost| bound.is_some_and(|b| c <= b + tol);
     if !settled && !proven(route.cost) {
         search.descend(&mut route, eps);
         if let Some(steps) = &opts.initial {
@@ -423,50 +425,16 @@ impl Dense {
         (0..=self.n).map(|i| self.arc(self.ex(r, i), self.en(r, i + 1))).sum()
     }
 
-    /// A lower bound on every route's transit cost, up to [`BOUND_UP_TO`] tasks: a route is a
+    /// The spanning trees over the tasks ([`Trees`]), up to [`BOUND_UP_TO`] tasks: a route is a
     /// path through home (if any) and every task, so a spanning tree over them, and none is
     /// cheaper than the minimum spanning tree whose edge between two tasks costs the cheapest
-    /// arc between their ends (Prim's algorithm, O(n²)). A single patch's raster, whose turns
-    /// join each pass to its nearest neighbour's near end, meets it: the search can stop there.
-    /// (Held–Karp penalties on the tree's degrees, tried on the four-patch cylinder section of
-    /// the spray benchmark, raised its bound only from 0.20 % to 0.17 % under the optimum in
-    /// 40 steps: not worth their time on plans this small.)
-    fn tree_bound(&self) -> Option<Cost> {
-        let n = self.n;
-        if n > BOUND_UP_TO {
-            return None;
-        }
-        let home = 2 * n as u32;
-        let edge = |a: usize, b: usize| -> Cost {
-            if a == n || b == n {
-                let t = 2 * (a + b - n) as u32;
-                return self.arc(home, t).min(self.arc(home, t + 1));
-            }
-            let (x, y) = (2 * a as u32, 2 * b as u32);
-            self.arc(x, y).min(self.arc(x, y + 1)).min(self.arc(x + 1, y)).min(self.arc(x + 1, y + 1))
-        };
-        // node n is home, when there is one
-        let nodes = n + usize::from(self.has_home);
-        let mut dist = vec![Cost::INFINITY; nodes];
-        let mut done = vec![false; nodes];
-        dist[0] = 0.0;
-        let mut total = 0.0;
-        for _ in 0..nodes {
-            let mut u = usize::MAX;
-            for v in 0..nodes {
-                if !done[v] && (u == usize::MAX || dist[v] < dist[u]) {
-                    u = v;
-                }
-            }
-            done[u] = true;
-            total += dist[u];
-            for v in 0..nodes {
-                if !done[v] {
-                    dist[v] = dist[v].min(edge(u, v));
-                }
-            }
-        }
-        Some(total)
+    /// arc between their ends ([`Trees::bound`]). A single patch's raster, whose turns join each
+    /// pass to its nearest neighbour's near end, meets it: the search can stop there. (Held–Karp
+    /// penalties on the tree's degrees, tried on the four-patch cylinder section of the spray
+    /// benchmark, raised its bound only from 0.20 % to 0.17 % under the optimum in 40 steps;
+    /// the branch and bound of [`Trees::prove`] settles it.)
+    fn trees(&self) -> Option<Trees<'_>> {
+        (self.n <= BOUND_UP_TO).then(|| Trees::new(&self.d, self.m, self.n, self.has_home))
     }
 
     fn nearest_neighbour(&self) -> Route {
@@ -1058,7 +1026,7 @@ mod tests {
                 let exact = solve_exact(&p).expect("exact runs").expect("an optimum");
                 // the transit part of the optimum (every task costs 3)
                 let opt = check(&p, &exact.steps).expect("feasible") - 8.0 * 3.0;
-                let bound = Dense::new(&p).expect("finite costs").tree_bound().expect("small");
+                let bound = Dense::new(&p).expect("finite costs").trees().expect("small").bound();
                 assert!(bound <= opt + 1e-9, "seed {seed} home {home}: bound {bound} above the optimum {opt}");
                 let r = solve_reversible(&p, &opts(400)).expect("solves");
                 if r.exact {
@@ -1111,7 +1079,7 @@ mod tests {
         assert!(r.exact, "not proven");
         assert_eq!(r.iterations, 0, "proven before any kick");
         let transit = r.solution.cost - 700.0 * n as f64;
-        let bound = Dense::new(&p).expect("finite costs").tree_bound().expect("small");
+        let bound = Dense::new(&p).expect("finite costs").trees().expect("small").bound();
         assert!(bound < transit - 1.0, "the tree bound alone ({bound}) already proves {transit}");
         let general = solve(&p, &opts(20_000)).expect("solves");
         assert!(r.solution.cost <= general.solution.cost + 1e-6, "{} vs {}", r.solution.cost, general.solution.cost);

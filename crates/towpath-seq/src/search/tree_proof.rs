@@ -69,6 +69,11 @@ impl<'a> Trees<'a> {
         Trees { d, m, n, has_home, k, w }
     }
 
+    /// The cost of the minimum spanning tree: no route's transits cost less.
+    pub(super) fn bound(&self) -> Cost {
+        prim(self.w.clone(), None, self.k).map_or(Cost::INFINITY, |t| t.total)
+    }
+
     #[inline]
     fn arc(&self, u: usize, v: usize) -> Cost {
         self.d[u * self.m + v]
@@ -238,38 +243,45 @@ impl Search<'_, '_> {
             self.req[a * k + b] = true;
             self.req[b * k + a] = true;
         }
-        // key: (not required, cost), smallest first
-        let mut key = vec![(true, Cost::INFINITY); k];
-        let mut parent = vec![0usize; k];
-        let mut done = vec![false; k];
-        let mut order = Vec::with_capacity(k);
-        key[0] = (false, 0.0);
-        let mut total = 0.0;
-        for _ in 0..k {
-            let mut u = usize::MAX;
-            for v in 0..k {
-                if !done[v] && (u == usize::MAX || key[v] < key[u]) {
-                    u = v;
-                }
-            }
-            if !key[u].1.is_finite() {
-                return None;
-            }
-            done[u] = true;
-            order.push(u);
-            total += key[u].1;
-            for v in 0..k {
-                let cand = (!self.req[u * k + v], w[u * k + v]);
-                if !done[v] && cand < key[v] {
-                    key[v] = cand;
-                    parent[v] = u;
-                }
+        prim(w, Some(&self.req), k)
+    }
+}
+
+/// Prim's algorithm over the `k × k` edge costs `w`, the `req`uired edges first: the minimum
+/// spanning tree that holds every required edge, or `None` when no spanning tree avoids the
+/// infinite (excluded) edges.
+fn prim(w: Vec<Cost>, req: Option<&[bool]>, k: usize) -> Option<Tree> {
+    // key: (not required, cost), smallest first
+    let mut key = vec![(true, Cost::INFINITY); k];
+    let mut parent = vec![0usize; k];
+    let mut done = vec![false; k];
+    let mut order = Vec::with_capacity(k);
+    key[0] = (false, 0.0);
+    let mut total = 0.0;
+    for _ in 0..k {
+        let mut u = usize::MAX;
+        for v in 0..k {
+            if !done[v] && (u == usize::MAX || key[v] < key[u]) {
+                u = v;
             }
         }
-        // The required edges all come from one tree (each child's constraints are its parent's
-        // tree's edges), so they form a forest and the tree holds every one of them.
-        Some(Tree { total, parent, order, w })
+        if !key[u].1.is_finite() {
+            return None;
+        }
+        done[u] = true;
+        order.push(u);
+        total += key[u].1;
+        for v in 0..k {
+            let cand = (!req.is_some_and(|r| r[u * k + v]), w[u * k + v]);
+            if !done[v] && cand < key[v] {
+                key[v] = cand;
+                parent[v] = u;
+            }
+        }
     }
+    // The required edges all come from one tree (each child's constraints are its parent's
+    // tree's edges), so they form a forest and the tree holds every one of them.
+    Some(Tree { total, parent, order, w })
 }
 
 /// A node's minimum spanning tree: its cost, each node's parent (node 0 is the root), the
