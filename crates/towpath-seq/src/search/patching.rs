@@ -21,15 +21,25 @@ use crate::cost::{Cost, CostModel};
 pub(crate) const PATCHING_UP_TO: usize = 600;
 
 /// The patched assignment tour, made to keep precedence; `None` when the problem is not of the
-/// kind (more than one mode on a task, consecutive groups, symmetric costs, too large or too
-/// small) or the deadline passes.
+/// kind (see [`arc_matrix`]) or the deadline passes.
+#[cfg(test)]
 pub(crate) fn assignment_patching<C: CostModel>(net: &Net<C>, deadline: Option<Instant>) -> Option<Seq> {
+    let c = arc_matrix(net, deadline)?;
+    let mut succ = Assignment::solve(&c, net.n).columns();
+    patch(&c, net.n, &mut succ);
+    tour_of(net, &succ)
+}
+
+/// The arc costs between the nodes of an asymmetric one-mode problem, row-major, for the
+/// assignment; `None` when the problem is not of the kind (more than one mode on a task,
+/// consecutive groups, symmetric costs, too large or too small) or the deadline passes. An arc
+/// into a node's own predecessor can be in no route and costs [`Net::forbidden`] (the closing
+/// arc into the node at position 0 is the wrap of the cyclic tour, always allowed).
+pub(crate) fn arc_matrix<C: CostModel>(net: &Net<C>, deadline: Option<Instant>) -> Option<Vec<Cost>> {
     let n = net.n;
     if !(4..=PATCHING_UP_TO).contains(&n) || net.multi_mode || net.has_groups || net.plain_symmetric {
         return None;
     }
-    // Arc costs between nodes; an arc into a node's own predecessor can be in no route (the
-    // closing arc into the node at position 0 is the wrap of the cyclic tour, always allowed).
     let mut c = vec![net.forbidden; n * n];
     for a in 0..n as u32 {
         if deadline.is_some_and(|d| Instant::now() >= d) {
@@ -41,9 +51,13 @@ pub(crate) fn assignment_patching<C: CostModel>(net: &Net<C>, deadline: Option<I
             }
         }
     }
-    let mut succ = assignment(&c, n);
-    patch(&c, n, &mut succ);
-    // The cycle from the anchor, as positions.
+    Some(c)
+}
+
+/// The route that follows the single cycle `succ` from the anchor, made to keep precedence (a
+/// stable topological order).
+pub(crate) fn tour_of<C: CostModel>(net: &Net<C>, succ: &[usize]) -> Option<Seq> {
+    let n = net.n;
     let mut pos = vec![0u32; n];
     let mut v = net.anchor as usize;
     for i in 0..n {
@@ -53,22 +67,62 @@ pub(crate) fn assignment_patching<C: CostModel>(net: &Net<C>, deadline: Option<I
     follow_order(net, &pos)
 }
 
-/// The cheapest assignment of `n` rows to `n` columns of the cost matrix `c` (row-major):
-/// `result[row] = column`. Shortest augmenting paths with potentials (Kuhn–Munkres in the form
-/// of Jonker & Volgenant 1987), O(n³).
-fn assignment(c: &[Cost], n: usize) -> Vec<usize> {
-    // 1-based inside; index 0 is the virtual column an augmentation starts from.
-    let mut u = vec![0.0; n + 1];
-    let mut v = vec![0.0; n + 1];
-    let mut row_of = vec![0usize; n + 1];
-    let mut way = vec![0usize; n + 1];
-    let mut minv = vec![Cost::INFINITY; n + 1];
-    let mut used = vec![false; n + 1];
-    for i in 1..=n {
+/// An optimal assignment of `n` rows to `n` columns of a cost matrix (row-major) with its dual
+/// potentials: shortest augmenting paths (Kuhn–Munkres in the form of Jonker & Volgenant 1987),
+/// O(n³) from scratch, O(n²) to reassign one row after its arc got dearer.
+#[derive(Clone)]
+pub(crate) struct Assignment {
+    /// Row and column potentials, 1-based; `c(i, j) - u[i] - v[j] >= 0`, zero on assigned arcs.
+    u: Vec<Cost>,
+    v: Vec<Cost>,
+    /// The row (1-based) assigned to each column (1-based), 0 when free; index 0 is the virtual
+    /// column an augmentation starts from.
+    row_of: Vec<usize>,
+}
+
+impl Assignment {
+    /// The cheapest assignment for the cost matrix `c`.
+    pub fn solve(c: &[Cost], n: usize) -> Self {
+        let mut a = Assignment { u: vec![0.0; n + 1], v: vec![0.0; n + 1], row_of: vec![0; n + 1] };
+        for i in 1..=n {
+            a.augment(c, n, i);
+        }
+        a
+    }
+
+    /// Re-solves after the arc `row → col` of the assignment was made dearer in `c` (and any
+    /// other costs raised): the row is freed and assigned again along one shortest augmenting
+    /// path. The potentials stay feasible because no cost went down.
+    pub fn reassign(&mut self, c: &[Cost], n: usize, row: usize, col: usize) {
+        debug_assert_eq!(self.row_of[col + 1], row + 1);
+        self.row_of[col + 1] = 0;
+        self.augment(c, n, row + 1);
+    }
+
+    /// The column of each row (0-based).
+    pub fn columns(&self) -> Vec<usize> {
+        let n = self.row_of.len() - 1;
+        let mut col_of = vec![0usize; n];
+        for j in 1..=n {
+            col_of[self.row_of[j] - 1] = j - 1;
+        }
+        col_of
+    }
+
+    /// The assignment's cost under `c`.
+    pub fn cost(&self, c: &[Cost]) -> Cost {
+        let n = self.row_of.len() - 1;
+        (1..=n).map(|j| c[(self.row_of[j] - 1) * n + j - 1]).sum()
+    }
+
+    /// Assigns the free row `i` (1-based) along a shortest augmenting path to a free column.
+    fn augment(&mut self, c: &[Cost], n: usize, i: usize) {
+        let Assignment { u, v, row_of } = self;
+        let mut way = vec![0usize; n + 1];
+        let mut minv = vec![Cost::INFINITY; n + 1];
+        let mut used = vec![false; n + 1];
         row_of[0] = i;
         let mut j0 = 0usize;
-        minv.fill(Cost::INFINITY);
-        used.fill(false);
         loop {
             used[j0] = true;
             let i0 = row_of[j0];
@@ -111,17 +165,12 @@ fn assignment(c: &[Cost], n: usize) -> Vec<usize> {
             }
         }
     }
-    let mut col_of = vec![0usize; n];
-    for j in 1..=n {
-        col_of[row_of[j] - 1] = j - 1;
-    }
-    col_of
 }
 
 /// Joins the cycles of the successor function `succ` into one: each time, over every pair of
 /// arcs `a → a'` and `b → b'` in different cycles, the exchange for `a → b'` and `b → a'` that
 /// costs least.
-fn patch(c: &[Cost], n: usize, succ: &mut [usize]) {
+pub(crate) fn patch(c: &[Cost], n: usize, succ: &mut [usize]) {
     let mut cycle = vec![usize::MAX; n];
     loop {
         cycle.fill(usize::MAX);
@@ -193,12 +242,36 @@ mod tests {
             let mut rng = Pcg64Mcg::seed_from_u64(seed);
             let n = 1 + (seed % 7) as usize;
             let c: Vec<Cost> = (0..n * n).map(|_| f64::from(rng.gen_range(0..50u32))).collect();
-            let col = assignment(&c, n);
+            let col = Assignment::solve(&c, n).columns();
             let mut seen = col.clone();
             seen.sort_unstable();
             assert_eq!(seen, (0..n).collect::<Vec<_>>(), "seed {seed}: not a permutation");
             let cost: Cost = (0..n).map(|r| c[r * n + col[r]]).sum();
             assert_eq!(cost, brute_force(&c, n), "seed {seed}");
+        }
+    }
+
+    #[test]
+    fn reassigning_a_dearer_row_matches_a_fresh_solve() {
+        for seed in 0..40u64 {
+            let mut rng = Pcg64Mcg::seed_from_u64(seed);
+            let n = 2 + (seed % 7) as usize;
+            let mut c: Vec<Cost> = (0..n * n).map(|_| f64::from(rng.gen_range(0..60u32))).collect();
+            let mut a = Assignment::solve(&c, n);
+            // Make assigned arcs dearer one after another (and an unassigned one), reassigning.
+            for _ in 0..n.min(4) {
+                let cols = a.columns();
+                let row = rng.gen_range(0..n);
+                let col = cols[row];
+                c[row * n + col] += f64::from(rng.gen_range(1..80u32));
+                let (i, j) = (rng.gen_range(0..n), rng.gen_range(0..n));
+                if cols[i] != j {
+                    c[i * n + j] += 5.0;
+                }
+                a.reassign(&c, n, row, col);
+                assert_eq!(a.cost(&c), Assignment::solve(&c, n).cost(&c), "seed {seed}");
+                assert_eq!(a.cost(&c), brute_force(&c, n), "seed {seed}");
+            }
         }
     }
 
@@ -248,7 +321,7 @@ mod tests {
             for i in 0..n {
                 c[i * n + i] = 1e12;
             }
-            let mut succ = assignment(&c, n);
+            let mut succ = Assignment::solve(&c, n).columns();
             let before: Cost = (0..n).map(|r| c[r * n + succ[r]]).sum();
             patch(&c, n, &mut succ);
             let mut x = 0;

@@ -331,6 +331,7 @@ mod tests {
                 threads: 1,
                 exact_up_to: 0,
                 seed,
+                assignment_branching: false,
                 ..SolveOptions::default()
             };
             let r = solve(&p, &opts).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
