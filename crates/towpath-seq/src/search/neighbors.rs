@@ -129,6 +129,59 @@ impl Neighbors {
     }
 }
 
+/// Nearest points looked at per task for its quadrant neighbours (a task at the edge of a
+/// cluster looks past the cluster's points for the next one on its empty side).
+const QUADRANT_SCAN: usize = 2_000;
+
+/// Candidate lists of each task's `near` nearest tasks and its `per_quadrant` nearest in each
+/// of the four quadrants around it, sorted by cost, for plain symmetric one-mode problems whose
+/// states lie in one plane (`None` otherwise). On clustered instances the nearest tasks all lie
+/// in a task's own cluster, so the arcs between clusters that a good tour needs are in no list;
+/// quadrant neighbours keep them (Johnson & McGeoch 2002, LKH's `QUADRANT` candidates).
+pub(crate) fn quadrant_lists<C: CostModel>(net: &Net<C>, near: usize, per_quadrant: usize) -> Option<Neighbors> {
+    if !net.plain_symmetric || net.multi_mode || net.depot != u32::MAX || net.n_tasks < 8 {
+        return None;
+    }
+    let n = net.n_tasks;
+    let cm = net.p.cost_model();
+    let point = |t: u32| net.p.modes(TaskId(t)).first().and_then(|m| cm.position(m.entry));
+    let z = point(0)?[2];
+    let mut pts = Vec::with_capacity(n);
+    for t in 0..n as u32 {
+        let p = point(t)?;
+        if !p.iter().all(|x| x.is_finite()) || p[2] != z {
+            return None;
+        }
+        pts.push([p[0], p[1]]);
+    }
+    let tree: RTree<GeomWithData<[f64; 2], u32>> =
+        RTree::bulk_load(pts.iter().enumerate().map(|(i, &p)| GeomWithData::new(p, i as u32)).collect());
+    let mut lists = Vec::with_capacity(n);
+    for (v, &p) in pts.iter().enumerate() {
+        let mut list: Vec<u32> = Vec::new();
+        let mut in_quadrant = [0usize; 4];
+        for nn in tree.nearest_neighbor_iter(&p).take(QUADRANT_SCAN) {
+            let u = nn.data;
+            if u as usize == v {
+                continue;
+            }
+            let q = pts[u as usize];
+            let quadrant = usize::from(q[0] >= p[0]) + 2 * usize::from(q[1] >= p[1]);
+            if list.len() < near || in_quadrant[quadrant] < per_quadrant {
+                list.push(u);
+                in_quadrant[quadrant] += 1;
+            }
+            if list.len() >= near && in_quadrant.iter().all(|&c| c >= per_quadrant) {
+                break;
+            }
+        }
+        let mut scored: Vec<(Cost, u32)> = list.iter().map(|&u| (min_arc(net, v as u32, u), u)).collect();
+        scored.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        lists.push(scored.into_iter().map(|(_, u)| u).collect());
+    }
+    Some(Neighbors::from_lists(net, lists))
+}
+
 fn count(s: &[u32]) -> u8 {
     s.iter().position(|&x| x == u32::MAX).unwrap_or(s.len()) as u8
 }
@@ -222,4 +275,59 @@ fn kd_candidates<C: CostModel>(net: &Net<C>, pts: &[[f64; 3]], owner: &[u32], k:
         out.push(cands);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64Mcg;
+
+    use super::*;
+    use crate::cost::{Metric, PointCost};
+    use crate::model::{Mode, Problem};
+
+    fn tour_problem(pts: Vec<[f64; 3]>) -> Problem<PointCost> {
+        let n = pts.len();
+        let mut b = Problem::builder(PointCost::new(pts, Metric::Euclidean));
+        for t in 0..n as u32 {
+            b.task(vec![Mode::new(StateId(t), StateId(t))]);
+        }
+        b.build().expect("valid problem")
+    }
+
+    #[test]
+    fn quadrant_lists_reach_across_clusters_that_nearest_lists_miss() {
+        // Two tight clusters of 60 points, 1,000 apart on the x axis.
+        let mut rng = Pcg64Mcg::seed_from_u64(7);
+        let pts: Vec<[f64; 3]> = (0..120)
+            .map(|i| {
+                let cx = if i < 60 { 0.0 } else { 1000.0 };
+                [cx + rng.gen_range(-10.0..10.0), rng.gen_range(-10.0..10.0), 0.0]
+            })
+            .collect();
+        let p = tour_problem(pts.clone());
+        let net = Net::new(&p);
+        let other = |v: u32, u: u32| (v < 60) != (u < 60);
+        let nearest = Neighbors::build(&net, 10);
+        assert!((0..120u32).all(|v| nearest.out(v).iter().all(|&u| !other(v, u))), "nearest lists stay at home");
+        let q = quadrant_lists(&net, 6, 1).expect("a planar symmetric tour");
+        let across = (0..120u32).filter(|&v| q.out(v).iter().any(|&u| other(v, u))).count();
+        // Every point of the left cluster's right edge sees the right cluster (its quadrants to
+        // the right hold no point of its own cluster) and vice versa.
+        let rightmost = (0..60u32).max_by(|&a, &b| pts[a as usize][0].total_cmp(&pts[b as usize][0])).unwrap();
+        assert!(q.out(rightmost).iter().any(|&u| u >= 60), "the rightmost left point sees no right point");
+        assert!(across >= 2, "only {across} lists reach across");
+        for v in 0..120u32 {
+            let list = q.out(v);
+            assert!(!list.contains(&v) && list.len() >= 6 && list.len() <= 10);
+            let costs: Vec<Cost> = list.iter().map(|&u| min_arc(&net, v, u)).collect();
+            assert!(costs.windows(2).all(|w| w[0] <= w[1]), "list of {v} not sorted by cost");
+        }
+    }
+
+    #[test]
+    fn quadrant_lists_need_a_plane() {
+        let p = tour_problem((0..20).map(|i| [f64::from(i), 0.0, f64::from(i % 2)]).collect());
+        assert!(quadrant_lists(&Net::new(&p), 6, 1).is_none());
+    }
 }
