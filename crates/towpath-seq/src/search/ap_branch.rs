@@ -275,7 +275,7 @@ fn cycles_of(succ: &[usize]) -> Vec<Vec<usize>> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use rand::{Rng, SeedableRng};
     use rand_pcg::Pcg64Mcg;
 
@@ -289,7 +289,7 @@ mod tests {
     /// A random asymmetric problem of `n` tasks with costs below `max_cost`; with `prec`, the
     /// first task pinned, a few precedence pairs along a hidden order and, on odd seeds, the
     /// last task pinned on an open route.
-    fn problem(seed: u64, n: usize, max_cost: u32, prec: bool) -> Problem<MatrixCost> {
+    pub(crate) fn problem(seed: u64, n: usize, max_cost: u32, prec: bool) -> Problem<MatrixCost> {
         let mut rng = Pcg64Mcg::seed_from_u64(seed);
         let data: Vec<Cost> =
             (0..n * n).map(|i| if i % (n + 1) == 0 { 0.0 } else { f64::from(rng.gen_range(0..max_cost)) }).collect();

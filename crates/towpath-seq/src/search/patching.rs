@@ -277,32 +277,12 @@ mod tests {
 
     #[test]
     fn the_patched_start_is_a_route_the_checker_accepts() {
-        use crate::cost::{MatrixCost, StateId};
-        use crate::model::{End, Mode, Problem, TaskId};
         use crate::search::tour::Tour;
         use crate::solution::check;
         for seed in 0..30u64 {
-            let mut rng = Pcg64Mcg::seed_from_u64(seed);
-            let n = 8 + (seed % 25) as usize;
-            let data: Vec<Cost> =
-                (0..n * n).map(|i| if i % (n + 1) == 0 { 0.0 } else { f64::from(rng.gen_range(0..100u32)) }).collect();
-            let mut b = Problem::builder(MatrixCost::new(n, data).expect("square"));
-            for t in 0..n as u32 {
-                b.task(vec![Mode::new(StateId(t), StateId(t))]);
-            }
-            // A few precedence pairs along a hidden order, the first task pinned (precedence
-            // needs an anchor) and, every other seed, the last one on an open route.
-            for _ in 0..n / 3 {
-                let (x, y) = (rng.gen_range(1..n as u32 - 1), rng.gen_range(1..n as u32 - 1));
-                if x < y {
-                    b.precede(TaskId(x), TaskId(y));
-                }
-            }
-            b.first(TaskId(0));
-            if seed % 2 == 0 {
-                b.last(TaskId(n as u32 - 1)).end(End::Free);
-            }
-            let p = b.build().expect("valid problem");
+            // Random costs, a few precedence pairs along a hidden order, the first task pinned
+            // and, every other seed, the last one on an open route.
+            let p = super::super::ap_branch::tests::problem(seed, 8 + (seed % 25) as usize, 100, true);
             let net = Net::new(&p);
             let (seq, mode) = assignment_patching(&net, None).expect("an asymmetric one-mode problem");
             let tour = Tour::new(&net, seq, mode);
