@@ -23,7 +23,7 @@ use std::time::Instant;
 
 use super::construct::Seq;
 use super::net::Net;
-use super::patching::{patch, tour_of, Assignment};
+use super::patching::{cycles_of, patch, tour_of, Assignment};
 use super::tour::Tour;
 use crate::cost::{Cost, CostModel};
 
@@ -55,9 +55,9 @@ pub(crate) struct Found {
 }
 
 /// Runs the branch and bound on the arc matrix `c` of `net` (see `patching::arc_matrix`) until
-/// `deadline`, the `cancel` flag or `max_nodes` nodes (one node: the patched assignment only), or after the root
-/// when its assignment is more than `max_root_gap` (a fraction) below its patched route; `None`
-/// when no route was found.
+/// `deadline`, the `cancel` flag or `max_nodes` nodes (one node: the patched assignment only),
+/// or after the root when its assignment is more than `max_root_gap` (a fraction) below its
+/// patched route; `None` when no route was found.
 pub(crate) fn search<C: CostModel>(
     net: &Net<C>,
     c: Vec<Cost>,
@@ -151,14 +151,14 @@ impl<C: CostModel> Search<'_, '_, C> {
         let succ = ap.columns();
         let cycles = cycles_of(&succ);
         let route = self.price_patched(&succ);
-        if self.nodes == 1 && route.is_some_and(|r| ap.cost(&self.work) < (1.0 - self.max_root_gap) * r) {
+        let lb = ap.cost(&self.work);
+        if self.nodes == 1 && route.is_some_and(|r| lb < (1.0 - self.max_root_gap) * r) {
             // A weak bound: branching would not close the gap in any time that pays.
             self.stopped = true;
             return;
         }
         if cycles.len() <= 1 {
             // A tour: the best route of its subtree if it keeps precedence as it is.
-            let lb = ap.cost(&self.work);
             if route.is_none_or(|r| r > lb + self.eps) {
                 self.inexact = true;
             }
@@ -253,25 +253,6 @@ impl<C: CostModel> Search<'_, '_, C> {
         }
         Some(cost)
     }
-}
-
-/// The cycles of a successor function, each as its nodes in order.
-fn cycles_of(succ: &[usize]) -> Vec<Vec<usize>> {
-    let mut seen = vec![false; succ.len()];
-    let mut out = Vec::new();
-    for s in 0..succ.len() {
-        if !seen[s] {
-            let mut cycle = Vec::new();
-            let mut x = s;
-            while !seen[x] {
-                seen[x] = true;
-                cycle.push(x);
-                x = succ[x];
-            }
-            out.push(cycle);
-        }
-    }
-    out
 }
 
 #[cfg(test)]

@@ -154,6 +154,21 @@ pub struct SolveReport {
     pub exact: bool,
 }
 
+impl SolveReport {
+    /// The report of a route proven optimal before any search (no kicks).
+    fn proven(solution: Solution, initial_cost: Option<Cost>, t0: Instant) -> Self {
+        let cost = solution.cost;
+        SolveReport {
+            solution,
+            initial_cost,
+            first_local_optimum: cost,
+            iterations: 0,
+            elapsed: t0.elapsed(),
+            exact: true,
+        }
+    }
+}
+
 /// Why a solve failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SolveError {
@@ -188,15 +203,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         None => None,
     };
     if let Some(solution) = small_exact(problem, opts)? {
-        let cost = solution.cost;
-        return Ok(SolveReport {
-            solution,
-            initial_cost,
-            first_local_optimum: cost,
-            iterations: 0,
-            elapsed: t0.elapsed(),
-            exact: true,
-        });
+        return Ok(SolveReport::proven(solution, initial_cost, t0));
     }
     let net = Net::new(problem);
     let threads = opts.threads.max(1);
@@ -206,14 +213,7 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         // Proven optimal by the branch and bound on the assignment.
         let steps = steps_from_tour(&net, tour);
         let cost = check(problem, &steps).map_err(SolveError::NoFeasibleRoute)?;
-        return Ok(SolveReport {
-            solution: Solution { steps, cost },
-            initial_cost,
-            first_local_optimum: cost,
-            iterations: 0,
-            elapsed: t0.elapsed(),
-            exact: true,
-        });
+        return Ok(SolveReport::proven(Solution { steps, cost }, initial_cost, t0));
     }
     let mut starts = construct_starts(&net, problem, opts, work, clock.deadline(), assigned.map(|(tour, _)| tour));
     let eps = 1e-9 * net.typical_arc;
@@ -268,10 +268,9 @@ fn small_exact<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Resul
 
 /// On asymmetric one-mode problems (ATSP, SOP), the best route of a truncated branch and bound
 /// on the assignment relaxation (see `ap_branch`), when the assignment's O(n³) fits in a
-/// twentieth of the time limit; the search gets at most `AP_BRANCH_SHARE` of the limit, and at
-/// most `AP_BRANCH_MAX` (or
-/// `AP_BRANCH_NODES_PER_NODE` nodes per node without one). Returns the route and whether the
-/// search proved it optimal.
+/// twentieth of the time limit; the search gets at most `AP_BRANCH_SHARE` of the limit and
+/// `AP_BRANCH_MAX` (`AP_BRANCH_NODES_PER_NODE` nodes per node without a limit). Returns the
+/// route and whether the search proved it optimal.
 fn assignment_start<C: CostModel>(net: &Net<C>, opts: &SolveOptions, clock: &Clock) -> Option<(Tour, bool)> {
     let deadline = clock.deadline();
     let affordable = opts.time_limit.is_none_or(|tl| (net.n as f64).powi(3) * 1e-9 <= tl.as_secs_f64() / 20.0);
@@ -328,8 +327,6 @@ fn construct_starts<C: CostModel>(
     }
     let pool =
         if net.depot != u32::MAX && problem.start().is_some() { vec![0] } else { construct::seed_pool(net, pool_size) };
-    // On asymmetric one-mode problems, the patched assignment (see `patching`) when its O(n³)
-    // fits in a twentieth of the time limit.
     starts.extend(assigned);
     let have_initial = opts.initial.is_some();
     for f in pool {

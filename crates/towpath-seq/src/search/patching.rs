@@ -171,22 +171,16 @@ impl Assignment {
 /// arcs `a → a'` and `b → b'` in different cycles, the exchange for `a → b'` and `b → a'` that
 /// costs least.
 pub(crate) fn patch(c: &[Cost], n: usize, succ: &mut [usize]) {
-    let mut cycle = vec![usize::MAX; n];
+    let mut cycle = vec![0usize; n];
     loop {
-        cycle.fill(usize::MAX);
-        let mut count = 0;
-        for s in 0..n {
-            if cycle[s] == usize::MAX {
-                let mut x = s;
-                while cycle[x] == usize::MAX {
-                    cycle[x] = count;
-                    x = succ[x];
-                }
-                count += 1;
-            }
-        }
-        if count <= 1 {
+        let cycles = cycles_of(succ);
+        if cycles.len() <= 1 {
             return;
+        }
+        for (id, nodes) in cycles.iter().enumerate() {
+            for &x in nodes {
+                cycle[x] = id;
+            }
         }
         let mut best = (Cost::INFINITY, 0, 0);
         for a in 0..n {
@@ -208,6 +202,25 @@ pub(crate) fn patch(c: &[Cost], n: usize, succ: &mut [usize]) {
         succ[a] = b2;
         succ[b] = a2;
     }
+}
+
+/// The cycles of a successor function, each as its nodes in order.
+pub(crate) fn cycles_of(succ: &[usize]) -> Vec<Vec<usize>> {
+    let mut seen = vec![false; succ.len()];
+    let mut out = Vec::new();
+    for s in 0..succ.len() {
+        if !seen[s] {
+            let mut cycle = Vec::new();
+            let mut x = s;
+            while !seen[x] {
+                seen[x] = true;
+                cycle.push(x);
+                x = succ[x];
+            }
+            out.push(cycle);
+        }
+    }
+    out
 }
 
 #[cfg(test)]
