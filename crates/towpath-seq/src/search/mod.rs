@@ -15,6 +15,7 @@ mod reversible;
 mod sop3;
 mod tour;
 mod tree_proof;
+mod two_way;
 
 /// Test problems shared by the search modules' tests.
 #[cfg(test)]
@@ -101,6 +102,10 @@ pub struct SolveOptions {
     /// its end the route is returned as proven optimal (default true; false leaves only the
     /// heuristic search, e.g. to test it).
     pub assignment_branching: bool,
+    /// Solve problems of two-way tasks (each done either way: two modes, each the other
+    /// reversed) without precedence as a symmetric tour over the tasks' ends, with a fixed edge
+    /// per task (default true; false searches the tasks and their modes directly).
+    pub two_way_ends: bool,
 }
 
 impl Default for SolveOptions {
@@ -116,6 +121,7 @@ impl Default for SolveOptions {
             exact_up_to: 10,
             stall_epochs: None,
             assignment_branching: true,
+            two_way_ends: true,
         }
     }
 }
@@ -131,6 +137,7 @@ impl std::fmt::Debug for SolveOptions {
             .field("exact_up_to", &self.exact_up_to)
             .field("stall_epochs", &self.stall_epochs)
             .field("assignment_branching", &self.assignment_branching)
+            .field("two_way_ends", &self.two_way_ends)
             .finish()
     }
 }
@@ -205,7 +212,47 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
     if let Some(solution) = small_exact(problem, opts)? {
         return Ok(SolveReport::proven(solution, initial_cost, t0));
     }
-    let net = Net::new(problem);
+    if opts.two_way_ends && two_way::applies(problem) {
+        if let Some(report) = two_way::solve(problem, opts, initial_cost, t0) {
+            return report;
+        }
+    }
+    search(problem, opts, clock, initial_cost, None)
+}
+
+/// [`solve`] on a problem whose fixed edges (see `two_way`) are given: `partner[v]` is the node
+/// tied to node `v`, or `two_way::NONE`.
+pub(crate) fn solve_inner<C: CostModel>(
+    problem: &Problem<C>,
+    opts: &SolveOptions,
+    partner: Option<Vec<u32>>,
+) -> Result<SolveReport, SolveError> {
+    let clock = Clock::for_options(opts);
+    let t0 = clock.started();
+    let initial_cost = match &opts.initial {
+        Some(steps) => Some(check(problem, steps).map_err(SolveError::BadInitial)?),
+        None => None,
+    };
+    if let Some(solution) = small_exact(problem, opts)? {
+        return Ok(SolveReport::proven(solution, initial_cost, t0));
+    }
+    search(problem, opts, clock, initial_cost, partner)
+}
+
+/// The heuristic search of [`solve`].
+fn search<C: CostModel>(
+    problem: &Problem<C>,
+    opts: &SolveOptions,
+    clock: Clock,
+    initial_cost: Option<Cost>,
+    partner: Option<Vec<u32>>,
+) -> Result<SolveReport, SolveError> {
+    let t0 = clock.started();
+    let mut net = Net::new(problem);
+    if let Some(partner) = partner {
+        net.partner = partner;
+    }
+    let net = net;
     let threads = opts.threads.max(1);
     let work = (problem.num_tasks() as f64).powi(2) * problem.max_modes() as f64;
     let assigned = assignment_start(&net, opts, &clock);
@@ -216,6 +263,16 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
         return Ok(SolveReport::proven(Solution { steps, cost }, initial_cost, t0));
     }
     let mut starts = construct_starts(&net, problem, opts, work, clock.deadline(), assigned.map(|(tour, _)| tour));
+    if !net.partner.is_empty() {
+        if opts.initial.is_some() && problem.num_tasks() > SPACE_FILLING_FROM {
+            // A space-filling curve through the ends of two-way tasks is a poor start: on 20,000
+            // random strokes its first descent took 4.5 s, the given start's 2.2 s.
+            starts.clear();
+        }
+        for t in &mut starts {
+            *t = keep_partners(&net, t);
+        }
+    }
     let eps = 1e-9 * net.typical_arc;
     let nb = candidate_lists(&net, &starts, opts, threads);
     let ils = Ils::new(&net, &nb, eps);
@@ -312,7 +369,7 @@ fn construct_starts<C: CostModel>(
     assigned: Option<Tour>,
 ) -> Vec<Tour> {
     let mut starts: Vec<Tour> = Vec::new();
-    if problem.num_tasks() > 12_000 {
+    if problem.num_tasks() > SPACE_FILLING_FROM {
         if let Some((seq, mode)) = construct::space_filling(net) {
             starts.push(Tour::new(net, seq, mode));
             return starts;
@@ -344,27 +401,76 @@ fn construct_starts<C: CostModel>(
 /// tours by the lowest-α ones when they are affordable (see `alpha`), else on planar ones by
 /// nearest and quadrant neighbours.
 fn candidate_lists<C: CostModel>(net: &Net<C>, starts: &[Tour], opts: &SolveOptions, threads: usize) -> Neighbors {
+    let nb = some_candidate_lists(net, starts, opts, threads);
+    if net.partner.is_empty() {
+        nb
+    } else {
+        nb.with_partners_first(net)
+    }
+}
+
+/// A tour with every node's fixed partner (see `two_way`) right after it, where it was not
+/// already beside it: the nodes keep their order otherwise.
+fn keep_partners<C: CostModel>(net: &Net<C>, tour: &Tour) -> Tour {
+    let mut placed = vec![false; net.n];
+    let mut seq = Vec::with_capacity(net.n);
+    for (i, &v) in tour.seq.iter().enumerate() {
+        if placed[v as usize] {
+            continue;
+        }
+        let p = net.partner[v as usize];
+        let prev = if i == 0 { tour.seq[net.n - 1] } else { tour.seq[i - 1] };
+        seq.push(v);
+        placed[v as usize] = true;
+        // a partner just before position 0 stays there (the pair wraps round the tour's end)
+        if p != two_way::NONE && !placed[p as usize] && !(i == 0 && prev == p) {
+            seq.push(p);
+            placed[p as usize] = true;
+        }
+    }
+    Tour::new(net, seq, vec![0; net.n])
+}
+
+fn some_candidate_lists<C: CostModel>(net: &Net<C>, starts: &[Tour], opts: &SolveOptions, threads: usize) -> Neighbors {
     // Wider lists pay off under precedence (measured on TSPLIB SOP and SOPLIB at equal time: 16
     // beat 10 and 24).
-    let k = if net.n > 20_000 {
+    let k: usize = if net.n > 20_000 {
         8
     } else if net.has_prec {
         16
     } else {
         10
     };
+    // The two ends of a short two-way task lie close together and take two places in every
+    // list near them: twice as many places keep as many tasks.
+    let k = if net.partner.is_empty() { k } else { LIST_FACTOR_ENDS * k };
+    // Not α on two-way tasks' ends: on 1,500 short strokes its lists left a 420-unit arc that
+    // a 2-opt move removes (the fixed edges distort the 1-trees); quadrant lists left none.
+    let alpha_steps =
+        alpha::plan(net.n, threads, opts.time_limit.map(|d| d.as_secs_f64())).filter(|_| net.partner.is_empty());
+    // Without α, nearest lists miss the arcs between clusters; quadrant neighbours keep them.
+    // gauss-10000 (100 clusters, 10 s, seeds 1-2): 1,588,315 / 1,572,931 -> 1,539,073 /
+    // 1,540,787 (fast-tsp 1,545,361 / 1,545,751); uniform 20,000 and portc-10000 within 0.06 %.
+    // (Built before the nearest lists, which they do not need: on 100,000 random points
+    // those take 1.4 s.)
+    let quadrants = || {
+        if net.has_prec || net.has_groups {
+            return None;
+        }
+        neighbors::quadrant_lists(net, k.saturating_sub(2 * QUADRANT_K).max(3), QUADRANT_K)
+    };
+    if alpha_steps.is_none() {
+        if let Some(lists) = quadrants() {
+            return lists;
+        }
+    }
     let nb = Neighbors::build(net, k);
-    if let Some(steps) = alpha::plan(net.n, threads, opts.time_limit.map(|d| d.as_secs_f64())) {
+    if let Some(steps) = alpha_steps {
         let ub = starts.iter().map(|t| t.cost).fold(Cost::INFINITY, Cost::min);
         if let Some(lists) = alpha::candidates(net, &nb, steps, ub, threads) {
             return lists;
         }
-    }
-    // Without α, nearest lists miss the arcs between clusters; quadrant neighbours keep them.
-    // gauss-10000 (100 clusters, 10 s, seeds 1-2): 1,588,315 / 1,572,931 -> 1,539,073 /
-    // 1,540,787 (fast-tsp 1,545,361 / 1,545,751); uniform 20,000 and portc-10000 within 0.06 %.
-    if !net.has_prec && !net.has_groups {
-        if let Some(lists) = neighbors::quadrant_lists(net, k.saturating_sub(2 * QUADRANT_K).max(3), QUADRANT_K) {
+        if let Some(lists) = quadrants() {
             return lists;
         }
     }
@@ -557,6 +663,13 @@ fn tour_from_steps<C: CostModel>(net: &Net<C>, steps: &[Step]) -> Tour {
 fn steps_from_tour<C: CostModel>(net: &Net<C>, tour: &Tour) -> Vec<Step> {
     tour.nodes().filter(|&(v, _)| v != net.depot).map(|(v, m)| Step { task: TaskId(v), mode: m }).collect()
 }
+
+/// How much longer the candidate lists of two-way tasks' ends are (see `two_way`).
+const LIST_FACTOR_ENDS: usize = 2;
+
+/// Above this many tasks the construction is a space-filling curve (nearest neighbour is
+/// quadratic).
+const SPACE_FILLING_FROM: usize = 12_000;
 
 /// Quadrant neighbours per quadrant in the candidate lists of large planar tours (see
 /// `neighbors::quadrant_lists`), beside the nearest ones that fill the rest of the list.

@@ -129,6 +129,25 @@ impl Neighbors {
     }
 }
 
+impl Neighbors {
+    /// The same lists with each node's fixed partner (see [`Net::partner`]) first, added where
+    /// it was missing: the search must be able to put a fixed edge back that a kick cut.
+    pub fn with_partners_first<C: CostModel>(self, net: &Net<C>) -> Self {
+        let lists: Vec<Vec<u32>> = (0..net.n_tasks as u32)
+            .map(|v| {
+                let p = net.partner[v as usize];
+                let mut list: Vec<u32> = Vec::with_capacity(self.out(v).len() + 1);
+                if p != u32::MAX {
+                    list.push(p);
+                }
+                list.extend(self.out(v).iter().copied().filter(|&u| u != p));
+                list
+            })
+            .collect();
+        Neighbors::from_lists(net, lists)
+    }
+}
+
 /// Nearest points looked at per task for its quadrant neighbours (a task at the edge of a
 /// cluster looks past the cluster's points for the next one on its empty side).
 const QUADRANT_SCAN: usize = 2_000;

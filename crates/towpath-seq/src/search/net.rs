@@ -72,6 +72,9 @@ pub(crate) struct Net<'p, C> {
     /// One mode per task, entering and leaving at the state with the task's own number, and no
     /// depot: an arc is the cost model's cost between the two node numbers.
     identity: bool,
+    /// The node each node is tied to by a fixed edge that every good tour uses (see
+    /// `two_way`), or `two_way::NONE`; empty when there are none.
+    pub partner: Vec<u32>,
 }
 
 /// Largest number of (node, mode) pairs for which the arcs are tabulated (a table of at most
@@ -180,6 +183,7 @@ impl<'p, C: CostModel> Net<'p, C> {
             dense: Vec::new(),
             dense_w: 0,
             identity: false,
+            partner: Vec::new(),
         };
         let (mean, max) = net.sample_arcs();
         net.typical_arc = mean;
@@ -333,6 +337,12 @@ impl<'p, C: CostModel> Net<'p, C> {
 
     /// The mean and the largest of a deterministic sample of finite transition costs (at
     /// least 1): the scale for "equal within rounding" and for the forbidden price.
+    /// True when `a`–`b` is a fixed edge (see [`Net::partner`]).
+    #[inline]
+    pub fn fixed(&self, a: u32, b: u32) -> bool {
+        self.partner.get(a as usize) == Some(&b)
+    }
+
     fn sample_arcs(&self) -> (Cost, Cost) {
         let n = self.n_tasks as u32;
         if n < 2 {
