@@ -234,11 +234,16 @@ fn placement(
     Placement { piece, path, reversed: c.reversed, lead_in: lead }
 }
 
-/// Time limit per stroke below which two-way strokes go to the stroke search instead of
-/// towpath's solver on their ends: the solver's first descent from the nearest-neighbour start
-/// takes about 0.6 s on 10,000 random strokes and 2.4 s on 20,000 (2 threads); on 100,000
-/// strokes at the default 5 s it did not finish and the stroke search was 10 % better.
-const TWO_WAY_SECONDS_PER_PIECE: f64 = 150e-6;
+/// Two-way strokes go to towpath's solver on their ends when the time limit is at least this
+/// many seconds times the square of the number of strokes (else to the stroke search): the
+/// solver's first descent from the nearest-neighbour start grows about quadratically (array
+/// reversals) and took about 0.6 s on 10,000 random strokes and 2.4 s on 20,000 (2 threads);
+/// on 100,000 strokes at the default 5 s it did not finish and the stroke search was 10 %
+/// better.
+const TWO_WAY_SECONDS: f64 = 1e-8;
+/// And at least this long (on 1,000 random strokes it needed 0.1 s; at 0.05 s it did not finish
+/// its first descent).
+const TWO_WAY_MIN_SECONDS: f64 = 0.1;
 
 /// Orders a drawing.
 pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutError> {
@@ -353,8 +358,11 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
         // Strokes drawn either way without precedence: towpath's solver on their ends (see
         // `towpath_seq::SolveOptions::two_way_ends`), from the nearest-neighbour start, when
         // the time limit leaves room for its first descent (else the stroke search).
-        let two_way = group_pairs.is_empty()
-            && opts.solve.time_limit.is_none_or(|tl| tl.as_secs_f64() >= group.len() as f64 * TWO_WAY_SECONDS_PER_PIECE)
+        let two_way = opts.solve.two_way_ends
+            && group_pairs.is_empty()
+            && opts.solve.time_limit.is_none_or(|tl| {
+                tl.as_secs_f64() >= TWO_WAY_MIN_SECONDS.max((group.len() as f64).powi(2) * TWO_WAY_SECONDS)
+            })
             && group.iter().all(|&i| {
                 matches!(&prep.candidates[i][..], [a, b] if a.entry == b.exit && a.exit == b.entry && a.entry != a.exit)
             });

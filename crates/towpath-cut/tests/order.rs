@@ -232,3 +232,44 @@ fn merged_strokes_are_drawn_head_to_tail() {
     // Merged travel: from the origin to the chain's nearer end (0,0) then to "far".
     assert!((r.travel_after - (0.0 + dist([60.0, 0.0], [200.0, 200.0]))).abs() < 1e-9, "{}", r.travel_after);
 }
+
+/// Open strokes without nesting go to towpath's solver on their ends (see
+/// `SolveOptions::two_way_ends`): every piece once with its geometry, and less pen-up than the
+/// stroke search at the same number of kicks.
+#[test]
+fn strokes_through_their_ends_beat_the_stroke_search() {
+    let mut rng = Pcg64::seed_from_u64(11);
+    let (mut ends_total, mut strokes_total) = (0.0, 0.0);
+    for case in 0..3u64 {
+        let d = drawing(
+            (0..400)
+                .map(|i| {
+                    let a = [rng.gen_range(0.0..500.0), rng.gen_range(0.0..500.0)];
+                    let b = [rng.gen_range(0.0..500.0), rng.gen_range(0.0..500.0)];
+                    piece(&format!("p{i}"), Path::polyline(&[a, b], false).unwrap())
+                })
+                .collect(),
+        );
+        let solve = SolveOptions {
+            time_limit: None,
+            iterations: Some(2000),
+            seed: case + 1,
+            threads: 1,
+            ..SolveOptions::default()
+        };
+        let o = OrderOptions { start: Some([0.0, 0.0]), solve, ..opts() };
+        let r = order(&d, &o).unwrap();
+        let v = verify(&d, &r.placements, &rules(&o));
+        assert!(v.ok(), "{}", v.problems());
+        assert!((v.travel - r.travel_after).abs() < 1e-6 * v.travel);
+        let mut seen: Vec<usize> = r.placements.iter().map(|p| p.piece).collect();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..400).collect::<Vec<_>>());
+        let o2 = OrderOptions { solve: SolveOptions { two_way_ends: false, ..o.solve.clone() }, ..o.clone() };
+        let r2 = order(&d, &o2).unwrap();
+        assert!(verify(&d, &r2.placements, &rules(&o2)).ok());
+        ends_total += r.travel_after;
+        strokes_total += r2.travel_after;
+    }
+    assert!(ends_total < strokes_total, "through the ends {ends_total}, stroke search {strokes_total}");
+}
