@@ -198,22 +198,16 @@ pub const MAX_THREADS: usize = 1024;
 
 /// Solves a problem with towpath's best solver: exactly when it is small, else nearest-neighbour
 /// starts, candidate lists, a first descent and the iterated local search in epochs (shared
-/// between threads at each epoch's end), then a last full descent.
+/// between threads at each epoch's end), then a last full descent. Problems of two-way tasks
+/// without precedence are searched as a tour over the tasks' ends (see
+/// [`SolveOptions::two_way_ends`]).
 pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<SolveReport, SolveError> {
-    if opts.threads > MAX_THREADS {
-        return Err(SolveError::TooManyThreads { threads: opts.threads });
-    }
-    let clock = Clock::for_options(opts);
-    let t0 = clock.started();
-    let initial_cost = match &opts.initial {
-        Some(steps) => Some(check(problem, steps).map_err(SolveError::BadInitial)?),
-        None => None,
+    let (clock, initial_cost) = match begin(problem, opts)? {
+        Begun::Proven(report) => return Ok(report),
+        Begun::Search(clock, initial_cost) => (clock, initial_cost),
     };
-    if let Some(solution) = small_exact(problem, opts)? {
-        return Ok(SolveReport::proven(solution, initial_cost, t0));
-    }
     if opts.two_way_ends && two_way::applies(problem) {
-        if let Some(report) = two_way::solve(problem, opts, initial_cost, t0) {
+        if let Some(report) = two_way::solve(problem, opts, clock.started(), initial_cost) {
             return report;
         }
     }
@@ -221,22 +215,42 @@ pub fn solve<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<
 }
 
 /// [`solve`] on a problem whose fixed edges (see `two_way`) are given: `partner[v]` is the node
-/// tied to node `v`, or `two_way::NONE`.
+/// tied to node `v`, or `two_way::NONE`. (Not `solve` itself: the ends of the ends' problem
+/// would be a type without end.)
 pub(crate) fn solve_inner<C: CostModel>(
     problem: &Problem<C>,
     opts: &SolveOptions,
-    partner: Option<Vec<u32>>,
+    partner: Vec<u32>,
 ) -> Result<SolveReport, SolveError> {
+    match begin(problem, opts)? {
+        Begun::Proven(report) => Ok(report),
+        Begun::Search(clock, initial_cost) => search(problem, opts, clock, initial_cost, Some(partner)),
+    }
+}
+
+/// How a solve begins.
+enum Begun {
+    /// Solved exactly by the dynamic programme.
+    Proven(SolveReport),
+    /// To search: the clock and the initial route's cost, if one was given.
+    Search(Clock, Option<Cost>),
+}
+
+/// What every solve does first: checks the thread count and the initial route, starts the
+/// clock, and solves small problems exactly.
+fn begin<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<Begun, SolveError> {
+    if opts.threads > MAX_THREADS {
+        return Err(SolveError::TooManyThreads { threads: opts.threads });
+    }
     let clock = Clock::for_options(opts);
-    let t0 = clock.started();
     let initial_cost = match &opts.initial {
         Some(steps) => Some(check(problem, steps).map_err(SolveError::BadInitial)?),
         None => None,
     };
     if let Some(solution) = small_exact(problem, opts)? {
-        return Ok(SolveReport::proven(solution, initial_cost, t0));
+        return Ok(Begun::Proven(SolveReport::proven(solution, initial_cost, clock.started())));
     }
-    search(problem, opts, clock, initial_cost, partner)
+    Ok(Begun::Search(clock, initial_cost))
 }
 
 /// The heuristic search of [`solve`].

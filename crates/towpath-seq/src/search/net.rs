@@ -335,14 +335,14 @@ impl<'p, C: CostModel> Net<'p, C> {
         }
     }
 
-    /// The mean and the largest of a deterministic sample of finite transition costs (at
-    /// least 1): the scale for "equal within rounding" and for the forbidden price.
     /// True when `a`–`b` is a fixed edge (see [`Net::partner`]).
     #[inline]
     pub fn fixed(&self, a: u32, b: u32) -> bool {
         self.partner.get(a as usize) == Some(&b)
     }
 
+    /// The mean and the largest of a deterministic sample of finite transition costs (at
+    /// least 1): the scale for "equal within rounding" and for the forbidden price.
     fn sample_arcs(&self) -> (Cost, Cost) {
         let n = self.n_tasks as u32;
         if n < 2 {

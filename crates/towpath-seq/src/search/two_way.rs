@@ -289,8 +289,8 @@ fn centroid<C: CostModel>(cm: &C, state: &[Option<StateId>]) -> Option<[f64; 3]>
 pub(crate) fn solve<C: CostModel>(
     problem: &Problem<C>,
     opts: &SolveOptions,
-    initial_cost: Option<Cost>,
     t0: Instant,
+    initial_cost: Option<Cost>,
 ) -> Option<Result<SolveReport, SolveError>> {
     let ends = Ends::build(problem)?;
     let mut topts = opts.clone();
@@ -301,7 +301,7 @@ pub(crate) fn solve<C: CostModel>(
         Arc::new(move |p: &Progress| cb(&Progress { best_cost: p.best_cost + offset, ..p.clone() }))
     });
     let partner = ends.problem.cost_model().partner.clone();
-    let report = match solve_inner(&ends.problem, &topts, Some(partner)) {
+    let report = match solve_inner(&ends.problem, &topts, partner) {
         Ok(r) => r,
         Err(e) => return Some(Err(e)),
     };
@@ -473,7 +473,7 @@ mod tests {
             let ends = Ends::build(&p).expect("buildable");
             let opts = SolveOptions { iterations: Some(3000), ..budget(case) };
             let partner = ends.problem.cost_model().partner.clone();
-            let r = solve_inner(&ends.problem, &opts, Some(partner)).unwrap();
+            let r = solve_inner(&ends.problem, &opts, partner).unwrap();
             let (steps, intact) = ends.route_of_ends(&r.solution.steps);
             assert!(intact, "case {case}: a fixed edge was cut");
             let c = check(&p, &steps).unwrap();
