@@ -56,5 +56,6 @@ pub(crate) fn finish<C: CostModel>(
         iterations,
         elapsed: clock.elapsed(),
         exact: false,
+        lower_bound: None,
     })
 }

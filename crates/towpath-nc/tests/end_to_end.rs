@@ -214,5 +214,7 @@ fn optimize_reports_its_stages_and_stops_when_cancelled() {
     };
     let t0 = std::time::Instant::now();
     assert!(matches!(optimize(&part.program, &part.machine, &d, &opts), Err(NcError::Cancelled)));
-    assert!(t0.elapsed() < Duration::from_secs(60), "{:?}", t0.elapsed());
+    // The first report comes within half a second, from the branch and bound on the
+    // assignment if it runs, else from the first epoch of kicks (at most 2 s).
+    assert!(t0.elapsed() < Duration::from_secs(20), "{:?}", t0.elapsed());
 }

@@ -57,7 +57,8 @@ pub(crate) struct Found {
 /// Runs the branch and bound on the arc matrix `c` of `net` (see `patching::arc_matrix`) until
 /// `deadline`, the `cancel` flag or `max_nodes` nodes (one node: the patched assignment only),
 /// or after the root when its assignment is more than `max_root_gap` (a fraction) below its
-/// patched route; `None` when no route was found.
+/// patched route; `None` when no route was found. `report` is given the best route's cost at
+/// most every [`REPORT_EVERY`] while the search runs.
 pub(crate) fn search<C: CostModel>(
     net: &Net<C>,
     c: Vec<Cost>,
@@ -65,6 +66,7 @@ pub(crate) fn search<C: CostModel>(
     cancel: Option<&AtomicBool>,
     max_nodes: u64,
     max_root_gap: f64,
+    report: Option<&dyn Fn(Cost)>,
 ) -> Option<Found> {
     let n = net.n;
     let root = Assignment::solve(&c, n);
@@ -88,6 +90,8 @@ pub(crate) fn search<C: CostModel>(
         stopped: false,
         inexact: false,
         max_root_gap,
+        report,
+        reported: Instant::now(),
     };
     s.visit(&root, 0);
     let (cost, seq) = s.best?;
@@ -119,7 +123,13 @@ struct Search<'a, 'p, C> {
     /// searched to the end.
     inexact: bool,
     max_root_gap: f64,
+    report: Option<&'a dyn Fn(Cost)>,
+    /// When `report` was last called (or the search began).
+    reported: Instant,
 }
+
+/// How often the branch and bound reports its best route while it runs.
+pub(crate) const REPORT_EVERY: std::time::Duration = std::time::Duration::from_millis(500);
 
 impl<C: CostModel> Search<'_, '_, C> {
     /// Whether a node with bound `lb` cannot hold a route cheaper than the best.
@@ -137,12 +147,19 @@ impl<C: CostModel> Search<'_, '_, C> {
 
     fn visit(&mut self, ap: &Assignment, depth: usize) {
         self.nodes += 1;
+        let now = Instant::now();
         if self.nodes > self.max_nodes
-            || self.deadline.is_some_and(|d| Instant::now() >= d)
+            || self.deadline.is_some_and(|d| now >= d)
             || self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
         {
             self.stopped = true;
             return;
+        }
+        if let (Some(report), Some((best, _))) = (self.report, &self.best) {
+            if now.duration_since(self.reported) >= REPORT_EVERY {
+                self.reported = now;
+                report(*best);
+            }
         }
         if depth > MAX_DEPTH {
             self.inexact = true;
@@ -309,7 +326,7 @@ pub(crate) mod tests {
             let p = problem(seed, n, if seed % 3 == 0 { 10 } else { 100 }, prec);
             let net = Net::new(&p);
             let c = arc_matrix(&net, None).expect("an asymmetric one-mode problem");
-            let found = search(&net, c, None, None, u64::MAX, 1.0).expect("a route");
+            let found = search(&net, c, None, None, u64::MAX, 1.0, None).expect("a route");
             let cost = checked(&p, &net, &found);
             assert!((cost - found.cost).abs() < 1e-9, "seed {seed}: says {} but costs {cost}", found.cost);
             let exact = solve_exact(&p).expect("small").expect("feasible").cost;
@@ -334,7 +351,7 @@ pub(crate) mod tests {
             let c = arc_matrix(&net, None).expect("an asymmetric one-mode problem");
             let (seq, mode) = super::super::patching::assignment_patching(&net, None).expect("patched start");
             let patched = Tour::new(&net, seq, mode).cost;
-            let found = search(&net, c, None, None, 50, 1.0).expect("a route");
+            let found = search(&net, c, None, None, 50, 1.0, None).expect("a route");
             assert!(found.nodes <= 51);
             let cost = checked(&p, &net, &found);
             assert!(cost <= patched + 1e-9, "seed {seed}: {cost} above the patched start {patched}");
@@ -359,8 +376,13 @@ pub(crate) mod tests {
             let r = solve(&p, &opts).expect("a route");
             let cost = check(&p, &r.solution.steps).expect("feasible");
             assert!((cost - r.solution.cost).abs() < 1e-9);
+            // the reported bound is below the optimum (the assignment relaxation, or the
+            // optimum itself when proven)
+            let exact = solve_exact(&p).expect("small").expect("feasible").cost;
+            let bound = r.lower_bound.expect("the assignment ran");
+            assert!(bound <= exact + 1e-9, "seed {seed}: bound {bound} above the optimum {exact}");
             if r.exact {
-                let exact = solve_exact(&p).expect("small").expect("feasible").cost;
+                assert!((bound - exact).abs() < 1e-9);
                 assert!((cost - exact).abs() < 1e-9, "seed {seed}: reported exact {cost}, optimum {exact}");
                 assert_eq!(r.iterations, 0, "seed {seed}: searched after a proof");
                 proven += 1;

@@ -159,6 +159,11 @@ pub struct SolveReport {
     /// on the assignment relaxation ran to its end (asymmetric one-mode problems), or (in
     /// [`solve_reversible`]) the route met a lower bound.
     pub exact: bool,
+    /// A lower bound on the cost of every route, when the solver has one: the optimum itself
+    /// when `exact`; else the assignment relaxation's value (asymmetric one-mode problems of up
+    /// to 600 tasks, when its branch and bound ran) or the spanning-tree bound of
+    /// [`solve_reversible`] (up to 200 tasks). `None` otherwise.
+    pub lower_bound: Option<Cost>,
 }
 
 impl SolveReport {
@@ -172,6 +177,7 @@ impl SolveReport {
             iterations: 0,
             elapsed: t0.elapsed(),
             exact: true,
+            lower_bound: Some(cost),
         }
     }
 }
@@ -270,7 +276,8 @@ fn search<C: CostModel>(
     let threads = opts.threads.max(1);
     let work = (problem.num_tasks() as f64).powi(2) * problem.max_modes() as f64;
     let assigned = assignment_start(&net, opts, &clock);
-    if let Some((tour, true)) = &assigned {
+    let lower_bound = assigned.as_ref().and_then(|a| a.bound);
+    if let Some(Assigned { tour, proven: true, .. }) = &assigned {
         // Proven optimal by the branch and bound on the assignment.
         let steps = steps_from_tour(&net, tour);
         let cost = check(problem, &steps).map_err(SolveError::NoFeasibleRoute)?;
@@ -282,7 +289,7 @@ fn search<C: CostModel>(
         // space-filling curve took 4.5 s, from the given start 2.2 s.
         Vec::new()
     } else {
-        construct_starts(&net, problem, opts, work, clock.deadline(), assigned.map(|(tour, _)| tour))
+        construct_starts(&net, problem, opts, work, clock.deadline(), assigned.map(|a| a.tour))
     };
     if !net.partner.is_empty() {
         for t in &mut starts {
@@ -321,7 +328,16 @@ fn search<C: CostModel>(
             solution = Solution { steps: init.clone(), cost: ic };
         }
     }
-    Ok(SolveReport { solution, initial_cost, first_local_optimum, iterations, elapsed: t0.elapsed(), exact: false })
+    let lower_bound = lower_bound.map(|b| b.min(solution.cost));
+    Ok(SolveReport {
+        solution,
+        initial_cost,
+        first_local_optimum,
+        iterations,
+        elapsed: t0.elapsed(),
+        exact: false,
+        lower_bound,
+    })
 }
 
 /// The exact answer of a problem small enough for the dynamic programme (few tasks, at most
@@ -344,7 +360,7 @@ fn small_exact<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Resul
 /// twentieth of the time limit; the search gets at most `AP_BRANCH_SHARE` of the limit and
 /// `AP_BRANCH_MAX` (`AP_BRANCH_NODES_PER_NODE` nodes per node without a limit). Returns the
 /// route and whether the search proved it optimal.
-fn assignment_start<C: CostModel>(net: &Net<C>, opts: &SolveOptions, clock: &Clock) -> Option<(Tour, bool)> {
+fn assignment_start<C: CostModel>(net: &Net<C>, opts: &SolveOptions, clock: &Clock) -> Option<Assigned> {
     let deadline = clock.deadline();
     let affordable = opts.time_limit.is_none_or(|tl| (net.n as f64).powi(3) * 1e-9 <= tl.as_secs_f64() / 20.0);
     if !affordable {
@@ -361,6 +377,14 @@ fn assignment_start<C: CostModel>(net: &Net<C>, opts: &SolveOptions, clock: &Clo
         (true, Some(_)) => u64::MAX,
         (true, None) => AP_BRANCH_NODES_PER_NODE * net.n as u64,
     };
+    // A front end hears from the search while it runs (it may take seconds).
+    let t0 = clock.started();
+    let report = opts.progress.as_ref().map(|cb| {
+        move |best: Cost| {
+            let fraction = budget_used(opts, t0, 0).unwrap_or(0.0);
+            cb(&Progress { elapsed: t0.elapsed(), best_cost: best, iterations: 0, fraction });
+        }
+    });
     let found = ap_branch::search(
         net,
         c,
@@ -368,8 +392,27 @@ fn assignment_start<C: CostModel>(net: &Net<C>, opts: &SolveOptions, clock: &Clo
         clock.cancel_flag().map(|c| c.as_ref()),
         max_nodes,
         ap_branch::MAX_ROOT_GAP,
+        report.as_ref().map(|r| r as &dyn Fn(Cost)),
     )?;
-    Some((Tour::new(net, found.seq.0, found.seq.1), found.proven && opts.assignment_branching))
+    // The assignment prices arcs only; every route also pays each task's one mode.
+    let modes: Cost = (0..net.n_tasks as u32).map(|t| net.mode_cost(t, 0)).sum();
+    let bound = (found.bound < 0.5 * net.forbidden).then_some(found.bound + modes);
+    Some(Assigned {
+        tour: Tour::new(net, found.seq.0, found.seq.1),
+        proven: found.proven && opts.assignment_branching,
+        bound,
+    })
+}
+
+/// What [`assignment_start`] found.
+struct Assigned {
+    /// The branch and bound's best route.
+    tour: Tour,
+    /// Whether the search proved it optimal.
+    proven: bool,
+    /// The root assignment's value plus the tasks' mode costs: a lower bound on every route
+    /// (`None` when the assignment needed a forbidden arc).
+    bound: Option<Cost>,
 }
 
 /// Construction: nearest neighbour from a seed pool sized to the budget (`work` arc

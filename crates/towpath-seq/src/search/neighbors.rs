@@ -86,6 +86,23 @@ impl Neighbors {
         Neighbors { k, out, out_len, inn: Vec::new(), inn_len: Vec::new(), out_lb, inn_lb: Vec::new(), symmetric: true }
     }
 
+    /// The same lists with each node's fixed partner (see [`Net::partner`]) first, added where
+    /// it was missing: the search must be able to put a fixed edge back that a kick cut.
+    pub fn with_partners_first<C: CostModel>(self, net: &Net<C>) -> Self {
+        let lists: Vec<Vec<u32>> = (0..net.n_tasks as u32)
+            .map(|v| {
+                let p = net.partner[v as usize];
+                let mut list: Vec<u32> = Vec::with_capacity(self.out(v).len() + 1);
+                if p != u32::MAX {
+                    list.push(p);
+                }
+                list.extend(self.out(v).iter().copied().filter(|&u| u != p));
+                list
+            })
+            .collect();
+        Neighbors::from_lists(net, lists)
+    }
+
     pub fn build<C: CostModel>(net: &Net<C>, k: usize) -> Self {
         let n = net.n_tasks;
         let k = k.min(n.saturating_sub(1)).max(1);
@@ -126,25 +143,6 @@ impl Neighbors {
         let out_len = (0..n).map(|v| count(&out[v * k..(v + 1) * k])).collect();
         let inn_len = if symmetric { Vec::new() } else { (0..n).map(|v| count(&inn[v * k..(v + 1) * k])).collect() };
         Neighbors { k, out, out_len, inn, inn_len, out_lb, inn_lb, symmetric }
-    }
-}
-
-impl Neighbors {
-    /// The same lists with each node's fixed partner (see [`Net::partner`]) first, added where
-    /// it was missing: the search must be able to put a fixed edge back that a kick cut.
-    pub fn with_partners_first<C: CostModel>(self, net: &Net<C>) -> Self {
-        let lists: Vec<Vec<u32>> = (0..net.n_tasks as u32)
-            .map(|v| {
-                let p = net.partner[v as usize];
-                let mut list: Vec<u32> = Vec::with_capacity(self.out(v).len() + 1);
-                if p != u32::MAX {
-                    list.push(p);
-                }
-                list.extend(self.out(v).iter().copied().filter(|&u| u != p));
-                list
-            })
-            .collect();
-        Neighbors::from_lists(net, lists)
     }
 }
 

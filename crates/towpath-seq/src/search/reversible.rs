@@ -176,13 +176,24 @@ pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions)
         route.seq.iter().map(|&t| Step { task: TaskId(t), mode: u32::from(route.dir[t as usize]) }).collect();
     let cost = check(problem, &steps).map_err(SolveError::NoFeasibleRoute)?;
     let exact = settled || proven(route.cost);
+    // The bound prices transitions like the route; the checked cost adds the passes' own.
+    let lower_bound = if exact { Some(cost) } else { bound.map(|b| b + (cost - route.cost)) };
     let mut solution = Solution { steps, cost };
     if let (Some(init), Some(ic)) = (&opts.initial, initial_cost) {
         if ic < solution.cost {
             solution = Solution { steps: init.clone(), cost: ic };
         }
     }
-    Ok(SolveReport { solution, initial_cost, first_local_optimum, iterations: kicks, elapsed: t0.elapsed(), exact })
+    let lower_bound = lower_bound.map(|b| b.min(solution.cost));
+    Ok(SolveReport {
+        solution,
+        initial_cost,
+        first_local_optimum,
+        iterations: kicks,
+        elapsed: t0.elapsed(),
+        exact,
+        lower_bound,
+    })
 }
 
 /// True when the problem is an open route over reversible segments the dense search takes.
@@ -1032,6 +1043,14 @@ mod tests {
                 if r.exact {
                     assert!((r.solution.cost - 24.0 - opt).abs() < 1e-6, "seed {seed}: proven but not optimal");
                 }
+                // the report's bound counts the tasks' own cost too
+                let reported = r.lower_bound.expect("a bound up to 200 tasks");
+                assert!(
+                    reported <= opt + 24.0 + 1e-9,
+                    "seed {seed}: reported bound {reported}, optimum {}",
+                    opt + 24.0
+                );
+                assert!(reported >= bound + 24.0 - 1e-9 || r.exact);
             }
         }
         // Two rasters far apart: the zigzag through both is a spanning tree of nearest ends.

@@ -323,6 +323,7 @@ pub(crate) fn solve<C: CostModel>(
         iterations: report.iterations,
         elapsed: t0.elapsed(),
         exact: report.exact && intact,
+        lower_bound: report.lower_bound.map(|b| b + offset),
     }))
 }
 

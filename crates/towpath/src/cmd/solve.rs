@@ -151,6 +151,8 @@ fn progress_bar(bounded: bool) -> Option<indicatif::ProgressBar> {
 fn print_answer(args: &Args, instance: &Instance, report: &SolveReport, cost: f64, threads: usize) {
     let tour = instance.answer(&report.solution.steps);
     let closed = with_problem!(&instance.problem, p => p.end() == End::Closed);
+    // The bound in the answer's units (the cost printed may leave out a fixed edge).
+    let lower_bound = report.lower_bound.map(|b| b + (cost - report.solution.cost));
     if args.json {
         let mut json = serde_json::json!({
             "file": args.file.display().to_string(),
@@ -165,6 +167,7 @@ fn print_answer(args: &Args, instance: &Instance, report: &SolveReport, cost: f6
             "time_seconds": report.elapsed.as_secs_f64(),
             "iterations": report.iterations,
             "exact": report.exact,
+            "lower_bound": lower_bound,
             "seed": args.seed,
             "threads": threads,
         });
@@ -192,7 +195,14 @@ fn print_answer(args: &Args, instance: &Instance, report: &SolveReport, cost: f6
         cost,
         report.elapsed.as_secs_f64(),
         report.iterations,
-        if report.exact { ", proven optimal" } else { "" },
+        match (report.exact, lower_bound) {
+            (true, _) => ", proven optimal".to_string(),
+            // (a bound far below says nothing: the assignment relaxation ignores precedence)
+            (false, Some(b)) if b > 0.0 && cost - b <= 0.5 * b => {
+                format!(", {:.2} % above a lower bound of {b}", 100.0 * (cost - b) / b)
+            }
+            _ => String::new(),
+        },
         args.solver.solver,
         args.seed,
         threads

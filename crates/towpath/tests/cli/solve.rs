@@ -102,6 +102,13 @@ fn every_solver_answers_and_says_which_ran() {
         let cost = v["cost"].as_f64().unwrap();
         assert_eq!(cost, br17_tour_cost(&tour), "{solver}: reported cost is the tour's");
         assert!(cost >= 39.0, "{solver}: {cost} below br17's optimum");
+        // towpath's solver reports a lower bound (the assignment relaxation, or the optimum once
+        // proven), the papers' solvers none
+        match (solver, v["lower_bound"].as_f64()) {
+            ("towpath", Some(b)) => assert!(b <= 39.0 + 1e-9, "bound {b} above br17's optimum"),
+            ("towpath", None) => panic!("no lower bound from towpath on an ATSP: {v}"),
+            (_, b) => assert!(b.is_none(), "{solver}: {b:?}"),
+        }
 
         let v = solve_json("ESC07.sop", &["--time-limit", "0.3", "--solver", solver]);
         assert_eq!(v["solver"], name);
