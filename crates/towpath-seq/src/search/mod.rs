@@ -293,7 +293,7 @@ fn search<C: CostModel>(
     };
     if !net.partner.is_empty() {
         for t in &mut starts {
-            *t = keep_partners(&net, t);
+            *t = two_way::keep_partners(&net, t);
         }
     }
     let eps = 1e-9 * net.typical_arc;
@@ -456,11 +456,10 @@ fn construct_starts<C: CostModel>(
     starts
 }
 
-/// The candidate neighbours of each node: the nearest ones, replaced on symmetric one-mode
-/// tours by the lowest-α ones when they are affordable (see `alpha`), else on planar ones by
-/// nearest and quadrant neighbours.
+/// The candidate neighbours of each node (see [`plain_candidate_lists`]), each node's fixed
+/// partner first where there are fixed edges (see `two_way`).
 fn candidate_lists<C: CostModel>(net: &Net<C>, starts: &[Tour], opts: &SolveOptions, threads: usize) -> Neighbors {
-    let nb = some_candidate_lists(net, starts, opts, threads);
+    let nb = plain_candidate_lists(net, starts, opts, threads);
     if net.partner.is_empty() {
         nb
     } else {
@@ -468,29 +467,15 @@ fn candidate_lists<C: CostModel>(net: &Net<C>, starts: &[Tour], opts: &SolveOpti
     }
 }
 
-/// A tour with every node's fixed partner (see `two_way`) right after it, where it was not
-/// already beside it: the nodes keep their order otherwise.
-fn keep_partners<C: CostModel>(net: &Net<C>, tour: &Tour) -> Tour {
-    let mut placed = vec![false; net.n];
-    let mut seq = Vec::with_capacity(net.n);
-    for (i, &v) in tour.seq.iter().enumerate() {
-        if placed[v as usize] {
-            continue;
-        }
-        let p = net.partner[v as usize];
-        let prev = if i == 0 { tour.seq[net.n - 1] } else { tour.seq[i - 1] };
-        seq.push(v);
-        placed[v as usize] = true;
-        // a partner just before position 0 stays there (the pair wraps round the tour's end)
-        if p != two_way::NONE && !placed[p as usize] && !(i == 0 && prev == p) {
-            seq.push(p);
-            placed[p as usize] = true;
-        }
-    }
-    Tour::new(net, seq, vec![0; net.n])
-}
-
-fn some_candidate_lists<C: CostModel>(net: &Net<C>, starts: &[Tour], opts: &SolveOptions, threads: usize) -> Neighbors {
+/// The nearest neighbours of each node, replaced on symmetric one-mode tours by the lowest-α
+/// ones when they are affordable (see `alpha`), else on planar ones by nearest and quadrant
+/// neighbours.
+fn plain_candidate_lists<C: CostModel>(
+    net: &Net<C>,
+    starts: &[Tour],
+    opts: &SolveOptions,
+    threads: usize,
+) -> Neighbors {
     // Wider lists pay off under precedence (measured on TSPLIB SOP and SOPLIB at equal time: 16
     // beat 10 and 24).
     let k: usize = if net.n > 20_000 {

@@ -22,6 +22,8 @@ use crate::cost::{Cost, CostModel, StateId};
 use crate::model::{End, Mode, Problem, TaskId};
 use crate::solution::{check, Solution, Step};
 
+use super::net::Net;
+use super::tour::Tour;
 use super::{solve_inner, Progress, ProgressFn, SolveError, SolveOptions, SolveReport};
 
 /// No node.
@@ -282,6 +284,29 @@ fn centroid<C: CostModel>(cm: &C, state: &[Option<StateId>]) -> Option<[f64; 3]>
         count += 1.0;
     }
     (count > 0.0).then(|| sum.map(|x| x / count))
+}
+
+/// A tour with every node's fixed partner (see [`Net::partner`]) right after it, where it was
+/// not already beside it: the nodes keep their order otherwise. Constructed starts pass through
+/// it, as they know nothing of fixed edges.
+pub(crate) fn keep_partners<C: CostModel>(net: &Net<C>, tour: &Tour) -> Tour {
+    let mut placed = vec![false; net.n];
+    let mut seq = Vec::with_capacity(net.n);
+    for (i, &v) in tour.seq.iter().enumerate() {
+        if placed[v as usize] {
+            continue;
+        }
+        let p = net.partner[v as usize];
+        let prev = if i == 0 { tour.seq[net.n - 1] } else { tour.seq[i - 1] };
+        seq.push(v);
+        placed[v as usize] = true;
+        // a partner just before position 0 stays there (the pair wraps round the tour's end)
+        if p != NONE && !placed[p as usize] && !(i == 0 && prev == p) {
+            seq.push(p);
+            placed[p as usize] = true;
+        }
+    }
+    Tour::new(net, seq, vec![0; net.n])
 }
 
 /// Solves a problem [`applies`] to through its ends; `None` when the transformed problem cannot
