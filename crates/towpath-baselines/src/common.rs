@@ -55,6 +55,8 @@ pub(crate) fn finish<C: CostModel>(
         first_local_optimum: first_cost,
         iterations,
         elapsed: clock.elapsed(),
+        // a baseline's iterations run from its start
+        search_elapsed: clock.elapsed(),
         exact: false,
         lower_bound: None,
     })

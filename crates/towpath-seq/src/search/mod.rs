@@ -155,6 +155,9 @@ pub struct SolveReport {
     pub iterations: u64,
     /// Wall time.
     pub elapsed: Duration,
+    /// Wall time of the kick phase alone (the iterated local search, after the candidate lists,
+    /// the starts and the first descent): `iterations` over it is the kick rate.
+    pub search_elapsed: Duration,
     /// True when the answer is proven optimal: the exact solver was used, the branch and bound
     /// on the assignment relaxation ran to its end (asymmetric one-mode problems), or (in
     /// [`solve_reversible`]) the route met a lower bound.
@@ -176,6 +179,7 @@ impl SolveReport {
             first_local_optimum: cost,
             iterations: 0,
             elapsed: t0.elapsed(),
+            search_elapsed: Duration::ZERO,
             exact: true,
             lower_bound: Some(cost),
         }
@@ -315,7 +319,9 @@ fn search<C: CostModel>(
     }
     let mut best = best.expect("at least one start");
     let first_local_optimum = best.cost;
+    let search_start = Instant::now();
     let iterations = search_epochs(&net, &ils, &mut best, opts, &clock, threads, eps);
+    let search_elapsed = search_start.elapsed();
     if !clock.cancelled() {
         ils.descend(&mut best, clock.deadline());
     }
@@ -335,6 +341,7 @@ fn search<C: CostModel>(
         first_local_optimum,
         iterations,
         elapsed: t0.elapsed(),
+        search_elapsed,
         exact: false,
         lower_bound,
     })

@@ -150,6 +150,7 @@ pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions)
     let mut trial = route.clone();
     // The kick that found the best route so far: the stall rule waits at least as long again.
     let mut found_at = 0u64;
+    let search_start = std::time::Instant::now();
     while search.n >= 4
         && !settled
         && !proven(route.cost)
@@ -191,6 +192,7 @@ pub fn solve_reversible<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions)
         first_local_optimum,
         iterations: kicks,
         elapsed: t0.elapsed(),
+        search_elapsed: search_start.elapsed(),
         exact,
         lower_bound,
     })

@@ -347,6 +347,7 @@ pub(crate) fn solve<C: CostModel>(
         first_local_optimum: report.first_local_optimum + offset,
         iterations: report.iterations,
         elapsed: t0.elapsed(),
+        search_elapsed: report.search_elapsed,
         exact: report.exact && intact,
         lower_bound: report.lower_bound.map(|b| b + offset),
     }))

@@ -166,6 +166,7 @@ fn print_answer(args: &Args, instance: &Instance, report: &SolveReport, cost: f6
             "tour": tour,
             "time_seconds": report.elapsed.as_secs_f64(),
             "iterations": report.iterations,
+            "search_seconds": report.search_elapsed.as_secs_f64(),
             "exact": report.exact,
             "lower_bound": lower_bound,
             "seed": args.seed,

@@ -242,3 +242,16 @@ fn other_commands_inputs_are_pointed_to_their_command() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("towpath route"), "{err}");
 }
+
+/// The kick phase's wall time comes with the kick count (their ratio is the kick rate): within
+/// the run's wall time, and above zero when kicks were done.
+#[test]
+fn json_gives_the_kick_phase_time() {
+    let v = solve_json("berlin52.tsp", &["--iterations", "3000"]);
+    assert_eq!(v["cost"], 7542.0, "berlin52's published optimum");
+    let kicks = v["iterations"].as_u64().unwrap();
+    let search = v["search_seconds"].as_f64().unwrap();
+    let total = v["time_seconds"].as_f64().unwrap();
+    assert!(kicks > 0, "{v}");
+    assert!(search > 0.0 && search <= total, "search {search} s of {total} s");
+}
