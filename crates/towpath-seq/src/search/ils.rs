@@ -272,17 +272,8 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         let net = self.net;
         let n = tour.len();
         if self.bridge4 && n >= 8 {
-            let cuts =
-                if long_bridges && rng.gen_ratio(1, LONG_BRIDGE_ONE_IN) { self.long_arc_cuts(tour, rng) } else { None };
-            return match cuts {
-                Some([h, j, k, l]) => {
-                    for x in tour.double_bridge(self.net, h + 1, j, k, l) {
-                        ls.push(x);
-                    }
-                    true
-                }
-                None => self.double_bridge(tour, rng, ls),
-            };
+            let long = long_bridges && rng.gen_ratio(1, LONG_BRIDGE_ONE_IN);
+            return self.double_bridge(tour, rng, ls, long);
         }
         if self.sop3_bridge {
             if let Some(ends) = super::sop3::bridge(net, tour, rng) {
@@ -353,15 +344,23 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
     /// The double bridge of Martin, Otto and Felten on three short consecutive segments: A B C D
     /// becomes A D C B, four arcs changed in two alternating cycles, which no sequential move
     /// undoes in one step. Plain symmetric one-mode tours only (no precedence, groups or modes).
-    fn double_bridge(&self, tour: &mut Tour, rng: &mut Pcg64Mcg, ls: &mut LocalSearch<'_, '_, C>) -> bool {
-        let n = tour.len();
-        let max_len = ((n - 2) / 3).clamp(1, BRIDGE_SEGMENT);
-        let (l1, l2, l3) = (rng.gen_range(1..=max_len), rng.gen_range(1..=max_len), rng.gen_range(1..=max_len));
-        let i = rng.gen_range(1..=n - l1 - l2 - l3);
-        let mut cuts = [i - 1, i + l1 - 1, i + l1 + l2 - 1, i + l1 + l2 + l3 - 1];
-        if !self.clear_of_fixed(tour, &mut cuts) {
-            return false;
-        }
+    /// With `long`, the cuts are at long arcs instead (see [`Ils::long_arc_cuts`]) where the
+    /// tour has four.
+    fn double_bridge(&self, tour: &mut Tour, rng: &mut Pcg64Mcg, ls: &mut LocalSearch<'_, '_, C>, long: bool) -> bool {
+        let cuts = match long.then(|| self.long_arc_cuts(tour, rng)).flatten() {
+            Some(cuts) => cuts,
+            None => {
+                let n = tour.len();
+                let max_len = ((n - 2) / 3).clamp(1, BRIDGE_SEGMENT);
+                let (l1, l2, l3) = (rng.gen_range(1..=max_len), rng.gen_range(1..=max_len), rng.gen_range(1..=max_len));
+                let i = rng.gen_range(1..=n - l1 - l2 - l3);
+                let mut cuts = [i - 1, i + l1 - 1, i + l1 + l2 - 1, i + l1 + l2 + l3 - 1];
+                if !self.clear_of_fixed(tour, &mut cuts) {
+                    return false;
+                }
+                cuts
+            }
+        };
         let [h, j, k, l] = cuts;
         for x in tour.double_bridge(self.net, h + 1, j, k, l) {
             ls.push(x);
@@ -377,15 +376,15 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
     /// lists) cannot: on 2,000 points in 40 Gaussian clusters, two of three seeds ended 0.7 %
     /// above the third with the clusters in another order before these kicks.
     fn long_arc_cuts(&self, tour: &Tour, rng: &mut Pcg64Mcg) -> Option<[usize; 4]> {
-        let n = tour.len();
         // (fixed edges are priced far below zero: the mean is over the others)
-        let free = |p: usize| {
-            let (a, b) = (tour.seq[p], tour.next_of_pos(p));
-            (!self.net.fixed(a, b)).then(|| tour.arc(self.net, a, b))
-        };
-        let (sum, count) = (0..n).filter_map(free).fold((0.0, 0usize), |(s, c), x| (s + x, c + 1));
-        let limit = LONG_ARC_FACTOR * sum / count.max(1) as Cost;
-        let long: Vec<usize> = (0..n).filter(|&p| free(p).is_some_and(|x| x > limit)).collect();
+        let arcs: Vec<(usize, Cost)> = (0..tour.len())
+            .filter_map(|p| {
+                let (a, b) = (tour.seq[p], tour.next_of_pos(p));
+                (!self.net.fixed(a, b)).then(|| (p, tour.arc(self.net, a, b)))
+            })
+            .collect();
+        let limit = LONG_ARC_FACTOR * arcs.iter().map(|&(_, x)| x).sum::<Cost>() / arcs.len().max(1) as Cost;
+        let long: Vec<usize> = arcs.iter().filter(|&&(_, x)| x > limit).map(|&(p, _)| p).collect();
         if long.len() < 4 {
             return None;
         }
