@@ -111,6 +111,11 @@ pub struct OrderReport {
     pub iterations: u64,
     /// Travel right after the solver, before entries were refined.
     pub travel_solved: f64,
+    /// A lower bound on the travel of every order that keeps the same rules, when the solver
+    /// proved one for every group: asked for with `solve.held_karp_bound`, given when every
+    /// group is of open strokes drawn either way (solved through their ends; Held–Karp bound).
+    /// `None` otherwise.
+    pub travel_lower_bound: Option<f64>,
 }
 
 #[derive(Clone, Debug)]
@@ -289,6 +294,7 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
     let mut solve_seconds = 0.0;
     let mut iterations = 0;
     let mut kept_pairs = 0;
+    let mut bound = opts.solve.held_karp_bound.then_some(0.0);
     for group in &groups {
         if group.is_empty() {
             continue;
@@ -358,14 +364,15 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
         // Strokes drawn either way without precedence: towpath's solver on their ends (see
         // `towpath_seq::SolveOptions::two_way_ends`), from the nearest-neighbour start, when
         // the time limit leaves room for its first descent (else the stroke search).
+        let strokes_only = group.iter().all(|&i| {
+            matches!(&prep.candidates[i][..], [a, b] if a.entry == b.exit && a.exit == b.entry && a.entry != a.exit)
+        });
         let two_way = opts.solve.two_way_ends
             && group_pairs.is_empty()
             && opts.solve.time_limit.is_none_or(|tl| {
                 tl.as_secs_f64() >= TWO_WAY_MIN_SECONDS.max((group.len() as f64).powi(2) * TWO_WAY_SECONDS)
             })
-            && group.iter().all(|&i| {
-                matches!(&prep.candidates[i][..], [a, b] if a.entry == b.exit && a.exit == b.entry && a.entry != a.exit)
-            });
+            && strokes_only;
         let (solved, solved_cost) =
             if opts.solver == SolverName::Towpath && greedy_ok && group.len() > opts.solve.exact_up_to && !two_way {
                 // towpath's solver on stroke tours: the stroke local search (2-opt, Or-opt and
@@ -389,6 +396,7 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
                 // The independent checker of towpath-seq vouches for the route and its cost.
                 let cost = check(&problem, &steps)
                     .map_err(|e| CutError::Solver(format!("the stroke search gave an invalid route: {e}")))?;
+                bound = None;
                 (steps, cost)
             } else {
                 let mut sopts = opts.solve.clone();
@@ -398,6 +406,12 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
                 let report = solve_with(opts.solver, &problem, &sopts, &opts.params)
                     .map_err(|e| CutError::Solver(e.to_string()))?;
                 iterations += report.iterations;
+                // Closed contours' entries move after the solver (`refine`), so a bound on the
+                // solver's candidates would not bound the result: strokes only.
+                bound = match (bound, report.lower_bound) {
+                    (Some(sum), Some(b)) if strokes_only => Some(sum + b),
+                    _ => None,
+                };
                 (report.solution.steps, report.solution.cost)
             };
         solve_seconds += t0.elapsed().as_secs_f64();
@@ -425,6 +439,7 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
         solve_seconds,
         iterations,
         travel_solved,
+        travel_lower_bound: bound,
     })
 }
 
@@ -659,6 +674,8 @@ pub fn order_merged(drawing: &Drawing, opts: &OrderOptions, tol: f64) -> Result<
     report.placements = expanded;
     report.travel_before = travel(opts.start, &crate::model::as_drawn(drawing));
     report.travel_after = travel(opts.start, &report.placements);
+    // the bound was on the merged strokes, whose joins are now drawn: not carried over
+    report.travel_lower_bound = None;
     Ok(report)
 }
 

@@ -491,6 +491,27 @@ mod tests {
         }
     }
 
+    /// The Held–Karp bound through the ends (the fixed edges at −M, the offset added back) is
+    /// a bound on the original routes: never above the exact optimum, and close below it.
+    #[test]
+    fn the_held_karp_bound_through_the_ends_is_below_the_optimum() {
+        let mut rng = Pcg64Mcg::seed_from_u64(6);
+        let mut ratios = Vec::new();
+        for case in 0..24u64 {
+            let strokes = 3 + (case % 4) as usize;
+            let p = problem(&mut rng, strokes, (case % 3) as usize, case % 2 == 0, (case / 2 % 3) as u8);
+            let best = solve_exact(&p).unwrap().unwrap().cost;
+            let r = crate::solve(&p, &SolveOptions { held_karp_bound: true, ..budget(case) }).unwrap();
+            let bound = r.lower_bound.expect("a bound through the ends");
+            assert!(bound <= best + 1e-9 * best.max(1.0), "case {case}: bound {bound} above the optimum {best}");
+            ratios.push(bound / best);
+            // not asked for, not given
+            assert_eq!(crate::solve(&p, &budget(case)).unwrap().lower_bound, None);
+        }
+        ratios.sort_by(f64::total_cmp);
+        assert!(ratios[ratios.len() / 2] >= 0.9, "median bound/optimum {ratios:?}");
+    }
+
     #[test]
     fn larger_problems_keep_every_fixed_edge_and_beat_the_task_level_search() {
         let mut rng = Pcg64Mcg::seed_from_u64(5);

@@ -125,6 +125,12 @@ pub struct Args {
     /// Print one JSON object with the totals instead of a summary.
     #[arg(long)]
     pub json: bool,
+    /// Prove how far from the least possible rapid travel the order can be: a Held–Karp lower
+    /// bound on every order, for drawings of open strokes drawn either way (solved through
+    /// their ends; up to 25,000 strokes per operation). Takes O(n²) time after the search: about
+    /// 0.5 s for 1,000 strokes, 13 s for 10,000.
+    #[arg(long)]
+    pub bound: bool,
     #[command(flatten)]
     pub solver: SolverArgs,
 }
@@ -185,8 +191,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (None, Some(_)) => None,
         (None, None) => Some(std::time::Duration::from_secs_f64((0.0002 * n as f64).clamp(0.1, 5.0))),
     };
-    let mut solve =
-        SolveOptions { time_limit, iterations: args.iterations, seed: args.seed, ..SolveOptions::default() };
+    let mut solve = SolveOptions {
+        time_limit,
+        iterations: args.iterations,
+        seed: args.seed,
+        held_karp_bound: args.bound,
+        ..SolveOptions::default()
+    };
     if let Some(t) = args.threads {
         solve.threads = t.max(1);
     }
@@ -255,6 +266,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "solve_seconds": report.solve_seconds,
             "seconds": seconds,
             "iterations": report.iterations,
+            "rapid_lower_bound": report.travel_lower_bound,
             "output": args.output.as_ref().map(|p| p.display().to_string()),
         });
         outln!("{v}");
@@ -265,6 +277,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         outln!("  pieces              : {n} ({closed} closed, {} operations)", drawing.operations.len());
         outln!("  rapid travel before : {:>14.3}", report.travel_before);
         outln!("  rapid travel after  : {:>14.3}  ({saved:.1} % less)", report.travel_after);
+        match report.travel_lower_bound {
+            Some(b) if b > 0.0 => outln!(
+                "  lower bound         : {b:>14.3}  (Held–Karp: no order travels less; this one is {:.2} % above)",
+                100.0 * (report.travel_after - b) / b
+            ),
+            Some(b) => outln!("  lower bound         : {b:>14.3}  (Held–Karp)"),
+            None if args.bound => {
+                outln!(
+                    "  lower bound         : none (only for open strokes drawn either way, solved through their ends)"
+                )
+            }
+            None => {}
+        }
         outln!("  reversed strokes    : {reversed}");
         outln!("  precedence          : {} pairs kept, 0 violations (verified)", report.precedence_pairs);
         outln!("  solver              : {} {:.2} s, total {seconds:.2} s", opts.solver, report.solve_seconds);

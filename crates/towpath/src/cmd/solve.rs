@@ -45,6 +45,12 @@ pub struct Args {
     /// Print one JSON object on stdout instead of a summary.
     #[arg(long)]
     pub json: bool,
+    /// After the search, prove how far from optimal the answer can be: a Held–Karp lower
+    /// bound (symmetric tours, and two-way tasks through their ends; up to 50,000 nodes),
+    /// printed as "x % above a lower bound of b" (JSON: lower_bound). Takes O(n²) time on top
+    /// of the time limit: about 1 s at 5,000 nodes, 13 s at 20,000.
+    #[arg(long)]
+    pub bound: bool,
     #[command(flatten)]
     pub solver: SolverArgs,
 }
@@ -80,6 +86,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         seed: args.seed,
         threads,
         progress,
+        held_karp_bound: args.bound,
         ..SolveOptions::default()
     };
     let name = args.solver.solver;
@@ -200,7 +207,8 @@ fn print_answer(args: &Args, instance: &Instance, report: &SolveReport, cost: f6
             (true, _) => ", proven optimal".to_string(),
             // (a bound far below says nothing: the assignment relaxation ignores precedence)
             (false, Some(b)) if b > 0.0 && cost - b <= 0.5 * b => {
-                format!(", {:.2} % above a lower bound of {b}", 100.0 * (cost - b) / b)
+                let shown = if b.fract() == 0.0 { format!("{b}") } else { format!("{b:.2}") };
+                format!(", {:.2} % above a lower bound of {shown}", 100.0 * (cost - b) / b)
             }
             _ => String::new(),
         },

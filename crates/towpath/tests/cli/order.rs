@@ -200,3 +200,48 @@ fn refused_input_names_file_and_line() {
     assert_eq!(code, 2);
     assert_eq!(std::fs::read_to_string(&s).unwrap(), SVG);
 }
+
+/// `--bound` on a drawing of open strokes: a Held–Karp lower bound at most the travel of the
+/// written order (measured from the file) and not far below it; none for closed contours,
+/// whose entries move after the solver.
+#[test]
+fn bound_on_strokes_is_below_the_written_travel() {
+    let dir = scratch("order-bound");
+    // 60 strokes from a fixed linear congruential sequence
+    let mut x: u64 = 12345;
+    let mut next = || {
+        x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (x >> 33) as f64 / (1u64 << 31) as f64 * 200.0
+    };
+    let mut body = String::new();
+    for i in 0..60 {
+        let (a, b, c, d) = (next(), next(), next(), next());
+        body.push_str(&format!("<path id=\"p{i}\" d=\"M {a:.3} {b:.3} L {c:.3} {d:.3}\" stroke=\"black\"/>\n"));
+    }
+    let svg = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"200\" height=\"200\" viewBox=\"0 0 200 200\">\n{body}</svg>"
+    );
+    let input = dir.join("strokes.svg");
+    std::fs::write(&input, &svg).unwrap();
+    let out = dir.join("out.svg");
+    let args = ["order", input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--start", "none"];
+    let v =
+        json_of(&towpath_out(&[&args[..], &["--iterations", "2000", "--threads", "1", "--bound", "--json"]].concat()));
+    let bound = v["rapid_lower_bound"].as_f64().expect("a bound for open strokes");
+    let (back, _) = read(Format::Svg, &std::fs::read_to_string(&out).unwrap(), "out", 1e-3).unwrap();
+    let travel: f64 = back.pieces.windows(2).map(|w| dist(w[0].path.end(), w[1].path.start)).sum();
+    assert!((travel - v["rapid_after"].as_f64().unwrap()).abs() < 1e-3);
+    assert!(bound <= travel + 1e-6, "bound {bound} above the written travel {travel}");
+    assert!(bound >= 0.8 * travel, "bound {bound} far below the travel {travel}");
+    // the summary names it
+    let o = towpath_out(&[&args[..], &["--iterations", "2000", "--threads", "1", "--bound"]].concat());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("lower bound") && text.contains("Held–Karp"), "{text}");
+    // closed contours: no bound, and the summary says why
+    let closed = dir.join("closed.svg");
+    std::fs::write(&closed, SVG).unwrap();
+    let c = ["order", closed.to_str().unwrap(), "--iterations", "50", "--threads", "1", "--bound"];
+    assert_eq!(json_of(&towpath_out(&[&c[..], &["--json"]].concat()))["rapid_lower_bound"], serde_json::Value::Null);
+    let o = towpath_out(&c);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("lower bound         : none"));
+}
