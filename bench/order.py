@@ -370,6 +370,9 @@ def bench_cut(args, results):
             tools.insert(1, ("vpype linesort --two-opt", lambda o: run_vpype(inp, o, True)))
             tools.append(("towpath order, 0.1x 2-opt time",
                           lambda o: run_towpath(inp, o, ["--time-limit", f"{tenth_of_two_opt(row):.4f}"])))
+            tools.append(("towpath order --no-inner-first, 0.1x 2-opt time",
+                          lambda o: run_towpath(inp, o, ["--no-inner-first", "--time-limit",
+                                                         f"{tenth_of_two_opt(row):.4f}"])))
         for name, fn in tools:
             times, pens, cpus = [], [], []
             SOLVE.clear()
@@ -391,13 +394,21 @@ def bench_cut(args, results):
             results.append(rec)
             print(json.dumps(rec), flush=True)
             row[name] = rec
+        # A floor no order can go below (Held–Karp, `--bound`): open strokes only, one run.
+        if n is not None and 2 * n <= 50_000:
+            _, stdout = timed([str(TOWPATH), "order", str(inp), "--start", "none", "--bound", "--json"])
+            rec = json.loads(stdout)
+            row["bound"] = rec["rapid_lower_bound"]
+            results.append({"case": label, "tool": "towpath order --bound", "bound": row["bound"],
+                            "rapid_after": rec["rapid_after"], "seconds": rec["seconds"]})
+            print(json.dumps(results[-1]), flush=True)
         rows.append(row)
     return rows
 
 
 def cut_table(rows):
-    out = ["| drawing | strokes | as drawn | vpype greedy | vpype 2-opt | towpath | towpath, no inner-first | towpath / 2-opt pen-up | towpath / 2-opt wall time | towpath in 0.1x 2-opt's time | its pen-up / 2-opt | its wall time / 2-opt |",
-           "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    out = ["| drawing | strokes | as drawn | vpype greedy | vpype 2-opt | towpath | towpath, no inner-first | towpath / 2-opt pen-up | towpath / 2-opt wall time | towpath in 0.1x 2-opt's time | its pen-up / 2-opt | its wall time / 2-opt | no inner-first in 0.1x 2-opt's time: pen-up / 2-opt | floor: Held–Karp bound on every order (/ 2-opt) |",
+           "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         def cell(name):
             rec = r.get(name)
@@ -409,9 +420,14 @@ def cut_table(rows):
         f = r.get("towpath order, 0.1x 2-opt time")
         fast_p = f"{f['penup_median'] / v2['penup_median']:.3f}" if f and v2 else "–"
         fast_t = f"{f['seconds_median'] / v2['seconds_median']:.3f}" if f and v2 else "–"
+        g = r.get("towpath order --no-inner-first, 0.1x 2-opt time")
+        free = (f"{g['penup_median']:,.0f} mm = {g['penup_median'] / v2['penup_median']:.3f} "
+                f"({g['seconds_median'] / v2['seconds_median']:.3f} of its time)" if g and v2 else "–")
+        b = r.get("bound")
+        floor = (f"{b:,.0f} mm" + (f" ({b / v2['penup_median']:.3f})" if v2 else "")) if b else "–"
         out.append(f"| {r['case']} | {r['strokes']:,} | {r['input_penup']:,.0f} mm | {cell('vpype linesort')} | {cell('vpype linesort --two-opt')} | "
                    f"{cell('towpath order')} | {cell('towpath order --no-inner-first')} | {ratio_p} | {ratio_t} | "
-                   f"{cell('towpath order, 0.1x 2-opt time') if f else 'not run'} | {fast_p} | {fast_t} |")
+                   f"{cell('towpath order, 0.1x 2-opt time') if f else 'not run'} | {fast_p} | {fast_t} | {free} | {floor} |")
     return "\n".join(out)
 
 

@@ -239,17 +239,6 @@ fn placement(
     Placement { piece, path, reversed: c.reversed, lead_in: lead }
 }
 
-/// Two-way strokes go to towpath's solver on their ends when the time limit is at least this
-/// many seconds times the square of the number of strokes (else to the stroke search): the
-/// solver's first descent from the nearest-neighbour start grows about quadratically (array
-/// reversals) and took about 0.6 s on 10,000 random strokes and 2.4 s on 20,000 (2 threads);
-/// on 100,000 strokes at the default 5 s it did not finish and the stroke search was 10 %
-/// better.
-const TWO_WAY_SECONDS: f64 = 1e-8;
-/// And at least this long (on 1,000 random strokes it needed 0.1 s; at 0.05 s it did not finish
-/// its first descent).
-const TWO_WAY_MIN_SECONDS: f64 = 0.1;
-
 /// Orders a drawing.
 pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutError> {
     let n = drawing.pieces.len();
@@ -362,17 +351,12 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
         let greedy_steps = greedy(&ends, &group_pairs, at);
         let greedy_ok = check(&problem, &greedy_steps).is_ok();
         // Strokes drawn either way without precedence: towpath's solver on their ends (see
-        // `towpath_seq::SolveOptions::two_way_ends`), from the nearest-neighbour start, when
-        // the time limit leaves room for its first descent (else the stroke search).
+        // `towpath_seq::SolveOptions::two_way_ends`), from the greedy-edge or the
+        // nearest-neighbour tour, whichever is shorter.
         let strokes_only = group.iter().all(|&i| {
             matches!(&prep.candidates[i][..], [a, b] if a.entry == b.exit && a.exit == b.entry && a.entry != a.exit)
         });
-        let two_way = opts.solve.two_way_ends
-            && group_pairs.is_empty()
-            && opts.solve.time_limit.is_none_or(|tl| {
-                tl.as_secs_f64() >= TWO_WAY_MIN_SECONDS.max((group.len() as f64).powi(2) * TWO_WAY_SECONDS)
-            })
-            && strokes_only;
+        let two_way = opts.solve.two_way_ends && group_pairs.is_empty() && strokes_only;
         let (solved, solved_cost) =
             if opts.solver == SolverName::Towpath && greedy_ok && group.len() > opts.solve.exact_up_to && !two_way {
                 // towpath's solver on stroke tours: the stroke local search (2-opt, Or-opt and
@@ -402,6 +386,21 @@ pub fn order(drawing: &Drawing, opts: &OrderOptions) -> Result<OrderReport, CutE
                 let mut sopts = opts.solve.clone();
                 if greedy_ok {
                     sopts.initial = Some(greedy_steps);
+                }
+                if two_way {
+                    // The greedy-edge tour when it is the shorter start: on 100,000 random
+                    // strokes the first descent from the nearest-neighbour tour does not
+                    // finish in 5 s, and the greedy one is the better tour to stop in.
+                    let nn: Vec<(usize, u32)> =
+                        sopts.initial.iter().flatten().map(|s| (s.task.index(), s.mode)).collect();
+                    if let Some(g) = greedy_matching(&ends, at) {
+                        if nn.is_empty() || pen_up(&ends, at, &g) < pen_up(&ends, at, &nn) {
+                            sopts.initial =
+                                Some(g.iter().map(|&(t, m)| Step { task: TaskId(t as u32), mode: m }).collect());
+                        }
+                    }
+                    // the starts' time counts against the limit
+                    sopts.time_limit = sopts.time_limit.map(|tl| tl.saturating_sub(t0.elapsed()));
                 }
                 let report = solve_with(opts.solver, &problem, &sopts, &opts.params)
                     .map_err(|e| CutError::Solver(e.to_string()))?;
