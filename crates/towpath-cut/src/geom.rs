@@ -62,10 +62,12 @@ pub struct Place {
     pub t: f64,
 }
 
-/// Distance between two points.
+/// Distance between two points: the square root of the squares (libm's `hypot`, which guards
+/// against overflow no drawing reaches, took 7 % of ordering 2,939 glyph outlines).
 #[inline]
 pub fn dist(a: P2, b: P2) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
+    let (dx, dy) = (a[0] - b[0], a[1] - b[1]);
+    (dx * dx + dy * dy).sqrt()
 }
 
 /// Squared distance from `p` to the segment `a`–`b` (no `hypot`, which guards against an

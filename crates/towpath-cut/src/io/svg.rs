@@ -458,16 +458,22 @@ fn subpaths(data: &usvg::tiny_skia_path::Path, m: &Affine) -> Vec<Path> {
     out
 }
 
-fn num(v: f64) -> String {
-    let v = if v == 0.0 { 0.0 } else { v };
-    format!("{v}")
+/// Appends a command letter and coordinates to path data, without a string per number.
+fn push_cmd(d: &mut String, cmd: char, pts: &[P2]) {
+    use std::fmt::Write;
+    d.push(cmd);
+    for (k, q) in pts.iter().enumerate() {
+        let (x, y) = (if q[0] == 0.0 { 0.0 } else { q[0] }, if q[1] == 0.0 { 0.0 } else { q[1] });
+        // writing to a String cannot fail
+        let _ = if k == 0 { write!(d, "{x} {y}") } else { write!(d, " {x} {y}") };
+    }
 }
 
 /// SVG path data of a path under `m` (arcs flattened within `tol`).
 fn path_data(path: &Path, m: &Affine, tol: f64) -> String {
     let mut d = String::new();
     let p = apply(m, path.start);
-    d.push_str(&format!("M{} {}", num(p[0]), num(p[1])));
+    push_cmd(&mut d, 'M', &[p]);
     let mut prev = path.start;
     let n = path.segs.len();
     for (i, s) in path.segs.iter().enumerate() {
@@ -479,27 +485,16 @@ fn path_data(path: &Path, m: &Affine, tol: f64) -> String {
         }
         match *s {
             Seg::Line(q) => {
-                let q = apply(m, q);
-                d.push_str(&format!("L{} {}", num(q[0]), num(q[1])));
+                push_cmd(&mut d, 'L', &[apply(m, q)]);
             }
             Seg::Cubic { c1, c2, to } => {
-                let (a, b, c) = (apply(m, c1), apply(m, c2), apply(m, to));
-                d.push_str(&format!(
-                    "C{} {} {} {} {} {}",
-                    num(a[0]),
-                    num(a[1]),
-                    num(b[0]),
-                    num(b[1]),
-                    num(c[0]),
-                    num(c[1])
-                ));
+                push_cmd(&mut d, 'C', &[apply(m, c1), apply(m, c2), apply(m, to)]);
             }
             Seg::Arc { .. } => {
                 let mut f = Vec::new();
                 seg_flatten(prev, s, tol, &mut f);
                 for q in f {
-                    let q = apply(m, q);
-                    d.push_str(&format!("L{} {}", num(q[0]), num(q[1])));
+                    push_cmd(&mut d, 'L', &[apply(m, q)]);
                 }
             }
         }
