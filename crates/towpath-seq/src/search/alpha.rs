@@ -161,9 +161,9 @@ const BOUND_ROUNDS: usize = 4;
 /// is then taken over the **complete** graph, so the bound does not rest on the candidate lists
 /// holding the minimum tree. Where that tree uses edges the sparse graph lacks, they are added
 /// and the ascent goes on from the same π (at most [`BOUND_ROUNDS`] times, while a round
-/// raises the bound); the best w(π) seen is the bound. Adds the nodes' own costs. `ub` is a tour's cost (the ascent's step
-/// length). `None` when the problem is not of that form or has more than [`BOUND_MAX_NODES`]
-/// nodes.
+/// raises the bound); the best w(π) seen is the bound. Adds the nodes' own costs. `ub` is a
+/// tour's cost (the ascent's step length). `None` when the problem is not of that form or has
+/// more than [`BOUND_MAX_NODES`] nodes.
 pub(crate) fn held_karp_bound<C: CostModel>(net: &Net<C>, nb: &Neighbors, ub: Cost) -> Option<Cost> {
     let n = net.n;
     if !net.plain_symmetric || net.multi_mode || net.has_prec || net.has_groups {
