@@ -1,7 +1,7 @@
 //! The heuristic against the exact DP on hundreds of seeded random small instances: closed and
 //! open routes, fixed starts and ends, asymmetric costs, precedence, consecutive groups, 1–4
 //! modes. Every answer must be feasible with the cost the checker computes, and (nearly) all
-//! must be optimal.
+//! must be optimal, and no lower bound the solver reports may exceed the optimum.
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -126,6 +126,7 @@ fn heuristic_matches_exact_on_random_small_instances() {
     let mut optimal = 0;
     let mut total = 0;
     let mut misses = Vec::new();
+    let mut bounded = 0;
     for seed in 0..300u64 {
         let Some(case) = random_case(seed) else { continue };
         let p = &case.problem;
@@ -148,9 +149,19 @@ fn heuristic_matches_exact_on_random_small_instances() {
             threads: 1,
             seed,
             exact_up_to: 0,
+            held_karp_bound: true,
             ..SolveOptions::default()
         };
         let rep = solve(p, &opts).unwrap_or_else(|e| panic!("{}: {e}", case.label));
+        // every bound the solver gives (Held–Karp, assignment, spanning tree) is one
+        if let Some(b) = rep.lower_bound {
+            assert!(
+                b <= exact_cost + 1e-6 * exact_cost.max(1.0),
+                "{}: bound {b} above the optimum {exact_cost}",
+                case.label
+            );
+            bounded += 1;
+        }
         let checked =
             check(p, &rep.solution.steps).unwrap_or_else(|v| panic!("{}: heuristic infeasible: {v}", case.label));
         assert!((checked - rep.solution.cost).abs() < 1e-6, "{}", case.label);
@@ -163,6 +174,7 @@ fn heuristic_matches_exact_on_random_small_instances() {
         }
     }
     assert!(total >= 200, "only {total} feasible cases");
+    assert!(bounded >= 50, "only {bounded} of {total} cases got a lower bound");
     // "nearly all": at most 1 % may miss the optimum
     assert!(misses.len() * 100 <= total, "{optimal}/{total} optimal; misses:\n{}", misses.join("\n"));
 }
