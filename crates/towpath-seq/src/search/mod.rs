@@ -114,8 +114,8 @@ pub struct SolveOptions {
     /// After the search, compute a Held–Karp lower bound (a 1-tree bound after a subgradient
     /// ascent; Held and Karp 1970) on symmetric one-mode tours and on two-way tasks through
     /// their ends, up to 50,000 nodes, and report it in [`SolveReport::lower_bound`]. It costs
-    /// O(n²) arc evaluations on top of the time limit (about 1 s at 5,000 nodes, 13 s at 20,000); default
-    /// false.
+    /// O(n²) arc evaluations on top of the time limit (about 1 s at 5,000 nodes, 13 s at
+    /// 20,000); default false.
     pub held_karp_bound: bool,
 }
 
