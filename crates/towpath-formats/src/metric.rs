@@ -3,7 +3,7 @@
 //! Traveling Salesman Problem Library", and its documentation of 1995). They live here, with
 //! the format that defines them, and reach the solver through [`PointMetric`].
 
-use towpath_seq::{ceil_nonneg, norm, Cost, Metric, PointMetric};
+use towpath_seq::{ceil_nonneg, norm, Cost, Metric, PointMetric, Rounding};
 
 /// The metric of a coordinate file (TSPLIB `EDGE_WEIGHT_TYPE` or towpath JSON `metric`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,6 +48,13 @@ impl PointMetric for FileMetric {
             FileMetric::Att => norm(extent[0], extent[1], 0.0) / 10f64.sqrt() + 1.0,
             // half the earth's circumference (acos ≤ π) plus the rounding
             FileMetric::Geo => GEO_RADIUS * std::f64::consts::PI + 1.0,
+        }
+    }
+
+    fn euclid_rounding(self) -> Option<Rounding> {
+        match self {
+            FileMetric::Plain(m) => m.euclid_rounding(),
+            FileMetric::Att | FileMetric::Geo => None,
         }
     }
 
@@ -99,6 +106,25 @@ mod tests {
         assert_eq!(p.cost(StateId(0), StateId(1)), 4.0);
         let q = PointCost::new(vec![[0.0, 0.0, 0.0], [30.0, 10.0, 0.0]], FileMetric::Att);
         assert_eq!(q.cost(StateId(0), StateId(1)), 10.0);
+    }
+
+    /// Only the plain Euclidean metrics offer their points for inline pricing, and those
+    /// points price every pair as the model does; ATT and GEO do not.
+    #[test]
+    fn only_euclidean_files_are_planar() {
+        let pts = vec![[0.0, 0.0, 0.0], [3.0, 4.5, 0.0], [-7.25, 1.5, 0.0]];
+        for m in [Metric::Euclidean, Metric::EuclideanNint, Metric::EuclideanCeil] {
+            let p = PointCost::new(pts.clone(), FileMetric::Plain(m));
+            let pl = p.planar_euclid().expect("plane points under a Euclidean metric");
+            for a in 0..3 {
+                for b in 0..3 {
+                    assert_eq!(pl.cost(a, b), p.cost(StateId(a as u32), StateId(b as u32)), "{m:?} {a} {b}");
+                }
+            }
+        }
+        for f in [FileMetric::Att, FileMetric::Geo, FileMetric::Plain(Metric::ManhattanNint)] {
+            assert!(PointCost::new(pts.clone(), f).planar_euclid().is_none(), "{f:?}");
+        }
     }
 
     #[test]

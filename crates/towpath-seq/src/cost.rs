@@ -68,6 +68,51 @@ pub trait CostModel: Send + Sync {
     fn cost_bound(&self) -> Option<Cost> {
         None
     }
+
+    /// When every cost is the Euclidean distance between two points of a plane (rounded as the
+    /// answer says), those points, by state: a solver may then compute costs inline in its
+    /// innermost loop. The answer must give exactly what [`CostModel::cost`] gives. `None`
+    /// (the default) means costs come only from `cost`.
+    fn planar_euclid(&self) -> Option<PlanarEuclid> {
+        None
+    }
+}
+
+/// How a Euclidean distance is rounded into a cost (see [`PlanarEuclid`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rounding {
+    /// Not rounded.
+    None,
+    /// To the nearest integer, halves up ([`nint`]).
+    Nint,
+    /// Up ([`ceil_nonneg`]).
+    Ceil,
+}
+
+/// Points of a plane whose rounded Euclidean distances are a model's costs (see
+/// [`CostModel::planar_euclid`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanarEuclid {
+    /// The point of each state.
+    pub xy: Vec<[f64; 2]>,
+    /// How a distance becomes a cost.
+    pub rounding: Rounding,
+}
+
+impl PlanarEuclid {
+    /// The cost between states `a` and `b`: the same arithmetic as [`Metric::cost`] with no
+    /// third coordinate.
+    #[inline(always)]
+    pub fn cost(&self, a: usize, b: usize) -> Cost {
+        let (p, q) = (self.xy[a], self.xy[b]);
+        let (dx, dy) = (p[0] - q[0], p[1] - q[1]);
+        let d = (dx * dx + dy * dy).sqrt();
+        match self.rounding {
+            Rounding::None => d,
+            Rounding::Nint => nint(d),
+            Rounding::Ceil => ceil_nonneg(d),
+        }
+    }
 }
 
 impl<C: CostModel + ?Sized> CostModel for &C {
@@ -85,6 +130,9 @@ impl<C: CostModel + ?Sized> CostModel for &C {
     }
     fn cost_bound(&self) -> Option<Cost> {
         (**self).cost_bound()
+    }
+    fn planar_euclid(&self) -> Option<PlanarEuclid> {
+        (**self).planar_euclid()
     }
 }
 
@@ -104,6 +152,9 @@ impl<C: CostModel + ?Sized> CostModel for Box<C> {
     fn cost_bound(&self) -> Option<Cost> {
         (**self).cost_bound()
     }
+    fn planar_euclid(&self) -> Option<PlanarEuclid> {
+        (**self).planar_euclid()
+    }
 }
 
 impl<C: CostModel + ?Sized> CostModel for Arc<C> {
@@ -121,6 +172,9 @@ impl<C: CostModel + ?Sized> CostModel for Arc<C> {
     }
     fn cost_bound(&self) -> Option<Cost> {
         (**self).cost_bound()
+    }
+    fn planar_euclid(&self) -> Option<PlanarEuclid> {
+        (**self).planar_euclid()
     }
 }
 
@@ -213,6 +267,12 @@ pub trait PointMetric: Copy + PartialEq + std::fmt::Debug + Send + Sync + 'stati
     /// near states (false for angles such as latitude and longitude).
     fn is_spatial(self) -> bool {
         true
+    }
+
+    /// When the cost is the Euclidean distance of the points, rounded as the answer says
+    /// (exactly the arithmetic of [`PlanarEuclid::cost`] where the third coordinates are 0).
+    fn euclid_rounding(self) -> Option<Rounding> {
+        None
     }
 }
 
@@ -310,6 +370,15 @@ impl PointMetric for Metric {
         !matches!(self, Metric::Euclidean | Metric::Manhattan)
     }
 
+    fn euclid_rounding(self) -> Option<Rounding> {
+        match self {
+            Metric::Euclidean => Some(Rounding::None),
+            Metric::EuclideanNint => Some(Rounding::Nint),
+            Metric::EuclideanCeil => Some(Rounding::Ceil),
+            Metric::Manhattan | Metric::ManhattanNint | Metric::MaximumNint => None,
+        }
+    }
+
     fn bound(self, extent: [f64; 3]) -> Cost {
         let [x, y, z] = extent;
         match self {
@@ -397,6 +466,15 @@ impl<M: PointMetric> CostModel for PointCost<M> {
         // Angles (latitude and longitude) would mislead a spatial tree near the poles and the
         // date line, so their neighbour lists come from the costs instead.
         self.metric.is_spatial().then(|| self.points[state.index()])
+    }
+
+    fn planar_euclid(&self) -> Option<PlanarEuclid> {
+        let rounding = self.metric.euclid_rounding()?;
+        // a third coordinate of -0.0 squares to +0.0 as 0.0 does, so "== 0.0" is enough
+        self.points
+            .iter()
+            .all(|p| p[2] == 0.0)
+            .then(|| PlanarEuclid { xy: self.points.iter().map(|p| [p[0], p[1]]).collect(), rounding })
     }
 }
 

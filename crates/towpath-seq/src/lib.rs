@@ -36,8 +36,8 @@ mod solution;
 
 pub use clock::Clock;
 pub use cost::{
-    ceil_nonneg, nint, norm, Cost, CostModel, MatrixCost, Metric, PointCost, PointMetric, StateId, EXACT_INTEGER_LIMIT,
-    MAX_ROUTE_COST,
+    ceil_nonneg, nint, norm, Cost, CostModel, MatrixCost, Metric, PlanarEuclid, PointCost, PointMetric, Rounding,
+    StateId, EXACT_INTEGER_LIMIT, MAX_ROUTE_COST,
 };
 pub use exact::{solve_exact, ExactError, MAX_EXACT_TASKS};
 pub use model::{End, Mode, ModelError, Problem, ProblemBuilder, TaskId};

@@ -5,7 +5,7 @@
 //! without a start state instead fixes an *anchor* task at position 0. Pinned first/last tasks
 //! become precedence edges, so every move that keeps precedence keeps them too.
 
-use crate::cost::{Cost, CostModel, StateId};
+use crate::cost::{Cost, CostModel, PlanarEuclid, StateId};
 use crate::model::{End, Problem, NO_GROUP};
 
 /// The least price the search puts on a forbidden (non-finite) transition; see [`Net::forbidden`].
@@ -72,6 +72,9 @@ pub(crate) struct Net<'p, C> {
     /// One mode per task, entering and leaving at the state with the task's own number, and no
     /// depot: an arc is the cost model's cost between the two node numbers.
     identity: bool,
+    /// With `identity`, the points when the costs are their (rounded) Euclidean distances in a
+    /// plane: the hot path then computes an arc inline, with no call into the cost model.
+    planar: Option<PlanarEuclid>,
     /// The node each node is tied to by a fixed edge that every good tour uses (see
     /// `two_way`), or `two_way::NONE`; empty when there are none.
     pub partner: Vec<u32>,
@@ -183,6 +186,7 @@ impl<'p, C: CostModel> Net<'p, C> {
             dense: Vec::new(),
             dense_w: 0,
             identity: false,
+            planar: None,
             partner: Vec::new(),
         };
         let (mean, max) = net.sample_arcs();
@@ -195,6 +199,9 @@ impl<'p, C: CostModel> Net<'p, C> {
                     && net.entry[net.mode_base[t] as usize] == StateId(t as u32)
                     && net.exit[net.mode_base[t] as usize] == StateId(t as u32)
             });
+        if net.identity {
+            net.planar = p.cost_model().planar_euclid().filter(|pl| pl.xy.len() >= n_tasks);
+        }
         net.tabulate();
         net.reversible_under_precedence();
         net
@@ -297,6 +304,17 @@ impl<'p, C: CostModel> Net<'p, C> {
         if self.dense_w != 0 {
             return self.dense[self.dense_index(a, ma) * self.dense_w + self.dense_index(b, mb)];
         }
+        if let Some(pl) = &self.planar {
+            // a distance: never negative, never NaN (the coordinates are finite)
+            return pl.cost(a as usize, b as usize).min(self.forbidden);
+        }
+        self.arc_by_model(a, ma, b, mb)
+    }
+
+    /// [`Net::arc`] through the cost model (kept out of line so that the table and planar
+    /// paths inline into the search's loops).
+    #[inline(never)]
+    fn arc_by_model(&self, a: u32, ma: u32, b: u32, mb: u32) -> Cost {
         if self.identity {
             return self.priced(self.p.transition(StateId(a), StateId(b)));
         }
@@ -468,7 +486,7 @@ fn csr(n: usize, edges: impl Iterator<Item = (u32, u32)> + Clone) -> (Vec<u32>, 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cost::MatrixCost;
+    use crate::cost::{MatrixCost, Metric, PointCost, PointMetric};
     use crate::model::Mode;
 
     /// The dense table gives every arc exactly as the cost model does, through modes, the depot
@@ -499,5 +517,51 @@ mod tests {
             }
         }
         assert_eq!(net.arc(1, 0, 2, 0), net.forbidden, "state 3 -> 4 is forbidden");
+    }
+
+    /// A closed tour through the points, one task per point.
+    fn points_tour(pts: Vec<[f64; 3]>, metric: Metric) -> Problem<PointCost> {
+        let n = pts.len();
+        let mut b = Problem::builder(PointCost::new(pts, metric));
+        for k in 0..n as u32 {
+            b.task(vec![Mode::point(StateId(k))]);
+        }
+        b.build().unwrap()
+    }
+
+    /// Too many points for the table: with plane points under a Euclidean metric every arc is
+    /// computed inline, and equals the cost model's price bit for bit (halves included: the
+    /// coordinates are on a grid of quarters, so many distances end in .5 exactly); other
+    /// metrics and points off the plane go through the model.
+    #[test]
+    fn planar_arcs_equal_the_cost_model() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
+        let n = DENSE_POINTS + 100;
+        let flat: Vec<[f64; 3]> =
+            (0..n).map(|_| [rng.gen_range(0..400) as f64 / 4.0, rng.gen_range(0..400) as f64 / 4.0, 0.0]).collect();
+        for metric in [Metric::Euclidean, Metric::EuclideanNint, Metric::EuclideanCeil, Metric::ManhattanNint] {
+            let p = points_tour(flat.clone(), metric);
+            let net = Net::new(&p);
+            assert_eq!(net.dense_w, 0, "{metric:?}: no table at {n} points");
+            assert_eq!(net.planar.is_some(), metric != Metric::ManhattanNint, "{metric:?}");
+            let mut halves = 0;
+            for _ in 0..20_000 {
+                let (a, b) = (rng.gen_range(0..n as u32), rng.gen_range(0..n as u32));
+                let want = p.transition(StateId(a), StateId(b));
+                assert_eq!(net.arc(a, 0, b, 0).to_bits(), want.to_bits(), "{metric:?}: arc {a} -> {b}");
+                let d = Metric::Euclidean.cost(&flat, a as usize, b as usize);
+                halves += usize::from(d.fract() == 0.5);
+            }
+            assert!(halves > 0, "some distances end in exactly one half");
+        }
+        let mut lifted = flat;
+        lifted[7][2] = 1.0;
+        let p = points_tour(lifted, Metric::EuclideanNint);
+        let net = Net::new(&p);
+        assert!(net.planar.is_none(), "a point off the plane");
+        for a in 0..50 {
+            assert_eq!(net.arc(a, 0, 7, 0), p.transition(StateId(a), StateId(7)));
+        }
     }
 }

@@ -14,12 +14,18 @@ pub(crate) struct Tour {
     journal: Vec<Entry>,
     saved: Vec<u32>,
     journaling: bool,
+    /// Room for a wrapped reversal (no allocation per move).
+    scratch: Vec<u32>,
 }
 
 #[derive(Clone, Debug)]
 enum Entry {
     /// seq[lo..lo+len] was overwritten; old values are at saved[at..at+len].
     Range { lo: u32, len: u32, at: u32 },
+    /// seq[lo..=hi] was reversed (undone by reversing it again: no copy is kept).
+    Reversed { lo: u32, hi: u32 },
+    /// The cyclic stretch from position `a` forward to `b` was reversed.
+    ReversedCyclic { a: u32, b: u32 },
     /// mode[node] was `old`.
     Mode { node: u32, old: u32 },
     /// cost was `old`.
@@ -32,7 +38,16 @@ impl Tour {
         for (i, &v) in seq.iter().enumerate() {
             pos[v as usize] = i as u32;
         }
-        let mut t = Tour { seq, pos, mode, cost: 0.0, journal: Vec::new(), saved: Vec::new(), journaling: false };
+        let mut t = Tour {
+            seq,
+            pos,
+            mode,
+            cost: 0.0,
+            journal: Vec::new(),
+            saved: Vec::new(),
+            journaling: false,
+            scratch: Vec::new(),
+        };
         t.cost = t.full_cost(net);
         t
     }
@@ -112,10 +127,10 @@ impl Tour {
                 Entry::Range { lo, len, at } => {
                     let (lo, len, at) = (lo as usize, len as usize, at as usize);
                     self.seq[lo..lo + len].copy_from_slice(&self.saved[at..at + len]);
-                    for i in lo..lo + len {
-                        self.pos[self.seq[i] as usize] = i as u32;
-                    }
+                    self.refresh_pos(lo, lo + len - 1);
                 }
+                Entry::Reversed { lo, hi } => self.flip_range(lo as usize, hi as usize),
+                Entry::ReversedCyclic { a, b } => self.flip_cyclic(a as usize, b as usize),
                 Entry::Mode { node, old } => self.mode[node as usize] = old,
                 Entry::Cost(c) => self.cost = c,
             }
@@ -144,11 +159,11 @@ impl Tour {
                 Some(Entry::Range { lo, len, at }) => {
                     let (lo, len, at) = (lo as usize, len as usize, at as usize);
                     self.seq[lo..lo + len].copy_from_slice(&self.saved[at..at + len]);
-                    for i in lo..lo + len {
-                        self.pos[self.seq[i] as usize] = i as u32;
-                    }
+                    self.refresh_pos(lo, lo + len - 1);
                     self.saved.truncate(at);
                 }
+                Some(Entry::Reversed { lo, hi }) => self.flip_range(lo as usize, hi as usize),
+                Some(Entry::ReversedCyclic { a, b }) => self.flip_cyclic(a as usize, b as usize),
                 Some(Entry::Mode { node, old }) => self.mode[node as usize] = old,
                 Some(Entry::Cost(c)) => self.cost = c,
                 None => break,
@@ -165,8 +180,8 @@ impl Tour {
     }
 
     fn refresh_pos(&mut self, lo: usize, hi: usize) {
-        for i in lo..=hi {
-            self.pos[self.seq[i] as usize] = i as u32;
+        for (k, &v) in (lo as u32..).zip(&self.seq[lo..=hi]) {
+            self.pos[v as usize] = k;
         }
     }
 
@@ -205,7 +220,14 @@ impl Tour {
 
     /// Reverses positions `i..=j`.
     pub fn reverse(&mut self, i: usize, j: usize) {
-        self.save_range(i, j);
+        if self.journaling {
+            self.journal.push(Entry::Reversed { lo: i as u32, hi: j as u32 });
+        }
+        self.flip_range(i, j);
+    }
+
+    /// Reverses positions `i..=j` without journaling (a reversal is its own undo).
+    fn flip_range(&mut self, i: usize, j: usize) {
         self.seq[i..=j].reverse();
         self.refresh_pos(i, j);
     }
@@ -213,22 +235,30 @@ impl Tour {
     /// Reverses the cyclic stretch from position `a` forward to position `b` (it may wrap past the
     /// end; position 0 then changes hands).
     pub fn reverse_cyclic(&mut self, a: usize, b: usize) {
-        let n = self.seq.len();
         if a <= b {
             self.reverse(a, b);
             return;
         }
-        self.save_range(a, n - 1);
-        self.save_range(0, b);
-        let m = n - a + b + 1;
-        let (mut x, mut y) = (a, b);
-        for _ in 0..m / 2 {
-            self.seq.swap(x, y);
-            self.pos[self.seq[x] as usize] = x as u32;
-            self.pos[self.seq[y] as usize] = y as u32;
-            x = if x + 1 == n { 0 } else { x + 1 };
-            y = if y == 0 { n - 1 } else { y - 1 };
+        if self.journaling {
+            self.journal.push(Entry::ReversedCyclic { a: a as u32, b: b as u32 });
         }
+        self.flip_cyclic(a, b);
+    }
+
+    /// Reverses the cyclic stretch from `a` forward to `b` (`a > b`) without journaling.
+    fn flip_cyclic(&mut self, a: usize, b: usize) {
+        // the stretch is seq[a..] then seq[..=b]: reversed through a scratch copy
+        let mut stretch = std::mem::take(&mut self.scratch);
+        stretch.clear();
+        stretch.extend_from_slice(&self.seq[a..]);
+        stretch.extend_from_slice(&self.seq[..=b]);
+        stretch.reverse();
+        let (tail, head) = stretch.split_at(self.seq.len() - a);
+        self.seq[a..].copy_from_slice(tail);
+        self.seq[..=b].copy_from_slice(head);
+        self.scratch = stretch;
+        self.refresh_pos(a, self.seq.len() - 1);
+        self.refresh_pos(0, b);
     }
 
     /// Rotates so that `v` is at position 0 (journaled).
@@ -306,5 +336,74 @@ impl Tour {
     /// Steps as (node, mode) pairs in order starting at position 0.
     pub fn nodes(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
         self.seq.iter().map(move |&v| (v, self.mode[v as usize]))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64Mcg;
+
+    use super::*;
+    use crate::search::testing::random_tour_problem;
+
+    /// `pos` is the inverse of `seq`.
+    fn consistent(t: &Tour) -> bool {
+        t.seq.iter().enumerate().all(|(i, &v)| t.pos[v as usize] as usize == i)
+    }
+
+    /// Random journaled changes (plain and wrapped reversals, segment moves and swaps, mode
+    /// changes, nested marks) are undone exactly: back at a mark, and back at the start, the
+    /// sequence, positions, modes and cost are what they were.
+    #[test]
+    fn journaled_changes_undo_exactly() {
+        let mut rng = Pcg64Mcg::seed_from_u64(11);
+        let p = random_tour_problem(&mut rng, 40, 100.0);
+        let net = Net::new(&p);
+        for round in 0..200 {
+            let n = 3 + rng.gen_range(0..38usize);
+            let mut seq: Vec<u32> = (0..n as u32).collect();
+            for i in (1..n).rev() {
+                seq.swap(i, rng.gen_range(0..=i));
+            }
+            let mut tour = Tour::new(&net, seq, vec![0; 40]);
+            let start = tour.clone();
+            tour.begin();
+            let mut snapshot: Option<(usize, Tour)> = None;
+            for step in 0..12 {
+                if step == 6 {
+                    let m = tour.mark();
+                    snapshot = Some((m, tour.clone()));
+                }
+                let (a, b) = (rng.gen_range(0..n), rng.gen_range(0..n));
+                match rng.gen_range(0..5) {
+                    0 => tour.reverse(a.min(b), a.max(b)),
+                    1 => tour.reverse_cyclic(a, b),
+                    2 if n >= 4 => {
+                        let (i, j) = (a.min(b).max(2), a.max(b).max(2));
+                        let k = rng.gen_range(0..i - 1);
+                        tour.move_segment(i, j, k, rng.gen_bool(0.5));
+                    }
+                    3 if a.min(b) + 1 < a.max(b) => {
+                        let (i, k) = (a.min(b), a.max(b));
+                        tour.swap_adjacent(i, rng.gen_range(i..k), k);
+                    }
+                    _ => tour.set_mode(tour.seq[a], rng.gen_range(0..3)),
+                }
+                tour.cost += 1.0;
+                assert!(consistent(&tour), "round {round} step {step}");
+            }
+            let (m, at_mark) = snapshot.expect("a mark was set");
+            tour.undo_to(m);
+            assert_eq!(
+                (&tour.seq, &tour.pos, &tour.mode),
+                (&at_mark.seq, &at_mark.pos, &at_mark.mode),
+                "round {round}"
+            );
+            assert_eq!(tour.cost, at_mark.cost);
+            tour.undo();
+            assert_eq!((&tour.seq, &tour.pos, &tour.mode), (&start.seq, &start.pos, &start.mode), "round {round}");
+            assert_eq!(tour.cost, start.cost);
+        }
     }
 }

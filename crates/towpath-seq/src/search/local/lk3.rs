@@ -125,10 +125,12 @@ impl<C: CostModel> LocalSearch<'_, '_, C> {
         // steps from t2 to x along the direction t1 -> t2
         let along = |tour: &Tour, x: u32| {
             let px = tour.pos[x as usize] as usize;
-            if forward {
-                (px + n - p2) % n
+            // positions are below n, so one conditional subtraction replaces a division
+            let d = if forward { px + n - p2 } else { p2 + n - px };
+            if d >= n {
+                d - n
             } else {
-                (p2 + n - px) % n
+                d
             }
         };
         let succ2 = succ(tour, t2);
