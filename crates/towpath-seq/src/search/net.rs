@@ -69,6 +69,9 @@ pub(crate) struct Net<'p, C> {
     dense: Vec<Cost>,
     /// Width of `dense` (0 when there is no table).
     dense_w: usize,
+    /// The table's index of every (node, mode) is the node's number (one mode per task, the
+    /// depot last): an arc is looked up with no mode arithmetic.
+    dense_by_node: bool,
     /// One mode per task, entering and leaving at the state with the task's own number, and no
     /// depot: an arc is the cost model's cost between the two node numbers.
     identity: bool,
@@ -185,6 +188,7 @@ impl<'p, C: CostModel> Net<'p, C> {
             typical_arc: 1.0,
             dense: Vec::new(),
             dense_w: 0,
+            dense_by_node: false,
             identity: false,
             planar: None,
             partner: Vec::new(),
@@ -260,6 +264,7 @@ impl<'p, C: CostModel> Net<'p, C> {
         }
         self.dense = dense;
         self.dense_w = w;
+        self.dense_by_node = of.iter().enumerate().all(|(k, &(v, m))| m == 0 && v as usize == k);
     }
 
     /// Index of `(v, m)` in the dense table: the global mode index, the depot last.
@@ -301,6 +306,9 @@ impl<'p, C: CostModel> Net<'p, C> {
     /// (non-finite) transitions priced at `self.forbidden` so that cost differences stay finite.
     #[inline]
     pub fn arc(&self, a: u32, ma: u32, b: u32, mb: u32) -> Cost {
+        if self.dense_by_node {
+            return self.dense[a as usize * self.dense_w + b as usize];
+        }
         if self.dense_w != 0 {
             return self.dense[self.dense_index(a, ma) * self.dense_w + self.dense_index(b, mb)];
         }
@@ -505,6 +513,7 @@ mod tests {
         let p = b.build().unwrap();
         let net = Net::new(&p);
         assert_eq!(net.dense_w, 7, "six modes and the depot");
+        assert!(!net.dense_by_node, "two tasks have several modes");
         let nodes: Vec<u32> = (0..net.n as u32).collect();
         for &a in &nodes {
             for ma in 0..net.num_modes(a) {
@@ -517,6 +526,35 @@ mod tests {
             }
         }
         assert_eq!(net.arc(1, 0, 2, 0), net.forbidden, "state 3 -> 4 is forbidden");
+    }
+
+    /// One mode per task: the table is indexed by node number (the depot last), and every
+    /// arc is still the cost model's, for an open route with a depot and for a cycle.
+    #[test]
+    fn table_by_node_matches_the_cost_model() {
+        let s = 6usize;
+        let mut m: Vec<Cost> = (0..s * s).map(|k| ((k * 29) % 17) as Cost - 3.0).collect();
+        m[2 * s + 5] = Cost::INFINITY;
+        let cost = MatrixCost::new(s, m).unwrap();
+        for open in [true, false] {
+            let mut b = Problem::builder(&cost);
+            for st in 1..s as u32 {
+                b.task(vec![Mode::point(StateId(st))]);
+            }
+            if open {
+                b.start(StateId(0)).end(End::Free);
+            }
+            let p = b.build().unwrap();
+            let net = Net::new(&p);
+            assert!(net.dense_by_node, "open {open}");
+            assert_eq!(net.dense_w, if open { s } else { s - 1 });
+            for a in 0..net.n as u32 {
+                for b in 0..net.n as u32 {
+                    let want = net.raw_arc(a, 0, b, 0).min(net.forbidden).max(-net.forbidden);
+                    assert_eq!(net.arc(a, 0, b, 0), want, "open {open}: arc {a} -> {b}");
+                }
+            }
+        }
     }
 
     /// A closed tour through the points, one task per point.
