@@ -18,7 +18,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use crate::cost::{Cost, CostModel, StateId};
+use crate::cost::{Cost, CostModel, PlanarEuclid, StateId};
 use crate::model::{End, Mode, Problem, TaskId};
 use crate::solution::{check, Solution, Step};
 
@@ -71,6 +71,25 @@ pub(crate) struct EndCost<'a, C> {
     m: Cost,
     /// Where the dummy sits for spatial candidate lists (the centroid of the other nodes).
     dummy_at: Option<[f64; 3]>,
+    /// When the original costs are plane distances ([`CostModel::planar_euclid`]): each node's
+    /// point, NaN for the dummy, so that pricing an arc reads no state and calls no model.
+    planar: Option<PlanarEuclid>,
+}
+
+impl<'a, C: CostModel> EndCost<'a, C> {
+    fn new(inner: &'a C, state: Vec<Option<StateId>>, partner: Vec<u32>, m: Cost, dummy_at: Option<[f64; 3]>) -> Self {
+        let planar = inner.planar_euclid().and_then(|pl| {
+            let xy = state
+                .iter()
+                .map(|s| match s {
+                    Some(s) => pl.xy.get(s.index()).copied(),
+                    None => Some([f64::NAN; 2]),
+                })
+                .collect::<Option<Vec<_>>>()?;
+            Some(PlanarEuclid { xy, rounding: pl.rounding })
+        });
+        EndCost { inner, state, partner, m, dummy_at, planar }
+    }
 }
 
 impl<C: CostModel> CostModel for EndCost<'_, C> {
@@ -82,6 +101,11 @@ impl<C: CostModel> CostModel for EndCost<'_, C> {
     fn cost(&self, from: StateId, to: StateId) -> Cost {
         if self.partner[from.index()] == to.0 {
             return -self.m;
+        }
+        if let Some(pl) = &self.planar {
+            // NaN only to or from the dummy: the real points are finite
+            let c = pl.cost(from.index(), to.index());
+            return if c.is_nan() { 0.0 } else { c };
         }
         match (self.state[from.index()], self.state[to.index()]) {
             (Some(a), Some(b)) => self.inner.cost(a, b),
@@ -168,7 +192,7 @@ impl<'a, C: CostModel> Ends<'a, C> {
         let m = 4.0 * transition_bound(cm, &state)? + 1.0;
         offset += m * fixed.len() as Cost;
         let dummy_at = centroid(cm, &state);
-        let cost = EndCost { inner: cm, state, partner, m, dummy_at };
+        let cost = EndCost::new(cm, state, partner, m, dummy_at);
         let nodes = cost.num_states() as u32;
         let mut b = Problem::builder(cost);
         for v in 0..nodes {
@@ -361,6 +385,35 @@ mod tests {
     use super::*;
     use crate::cost::{Metric, PointCost};
     use crate::exact::solve_exact;
+
+    /// With plane points the end nodes' costs are computed from each node's own point; they
+    /// equal, bit for bit, the costs read through the nodes' states (fixed edges at −M, the
+    /// dummy at 0), for every start and end kind.
+    #[test]
+    fn planar_end_costs_equal_the_state_costs() {
+        let mut rng = Pcg64Mcg::seed_from_u64(5);
+        for (start, end) in [(true, 0), (false, 0), (true, 2), (false, 2), (true, 1), (false, 1)] {
+            let p = problem(&mut rng, 12, 3, start, end);
+            let ends = Ends::build(&p).expect("two-way tasks");
+            let cm = ends.problem.cost_model();
+            assert!(cm.planar.is_some(), "plane points under a Euclidean metric");
+            let n = cm.num_states() as u32;
+            for a in 0..n {
+                for b in 0..n {
+                    let want = if cm.partner[a as usize] == b {
+                        -cm.m
+                    } else {
+                        match (cm.state[a as usize], cm.state[b as usize]) {
+                            (Some(x), Some(y)) => p.cost_model().cost(x, y),
+                            _ => 0.0,
+                        }
+                    };
+                    let got = cm.cost(StateId(a), StateId(b));
+                    assert_eq!(got.to_bits(), want.to_bits(), "start {start} end {end}: {a} -> {b}");
+                }
+            }
+        }
+    }
 
     /// `strokes` two-way tasks and `points` point tasks at random in a 100 × 100 square, with
     /// the given start and end.
