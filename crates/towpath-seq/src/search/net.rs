@@ -75,8 +75,9 @@ pub(crate) struct Net<'p, C> {
     /// One mode per task, entering and leaving at the state with the task's own number, and no
     /// depot: an arc is the cost model's cost between the two node numbers.
     identity: bool,
-    /// With `identity`, the points when the costs are their (rounded) Euclidean distances in a
-    /// plane: the hot path then computes an arc inline, with no call into the cost model.
+    /// With `identity` and no table, the points when the costs are their (rounded) Euclidean
+    /// distances in a plane: the hot path then computes an arc inline, with no call into the
+    /// cost model.
     planar: Option<PlanarEuclid>,
     /// The node each node is tied to by a fixed edge that every good tour uses (see
     /// `two_way`), or `two_way::NONE`; empty when there are none.
@@ -203,10 +204,10 @@ impl<'p, C: CostModel> Net<'p, C> {
                     && net.entry[net.mode_base[t] as usize] == StateId(t as u32)
                     && net.exit[net.mode_base[t] as usize] == StateId(t as u32)
             });
-        if net.identity {
+        net.tabulate();
+        if net.identity && net.dense_w == 0 {
             net.planar = p.cost_model().planar_euclid().filter(|pl| pl.xy.len() >= n_tasks);
         }
-        net.tabulate();
         net.reversible_under_precedence();
         net
     }
