@@ -122,19 +122,7 @@ impl Tour {
 
     /// Restores the state saved by [`Tour::begin`].
     pub fn undo(&mut self) {
-        while let Some(e) = self.journal.pop() {
-            match e {
-                Entry::Range { lo, len, at } => {
-                    let (lo, len, at) = (lo as usize, len as usize, at as usize);
-                    self.seq[lo..lo + len].copy_from_slice(&self.saved[at..at + len]);
-                    self.refresh_pos(lo, lo + len - 1);
-                }
-                Entry::Reversed { lo, hi } => self.flip_range(lo as usize, hi as usize),
-                Entry::ReversedCyclic { a, b } => self.flip_cyclic(a as usize, b as usize),
-                Entry::Mode { node, old } => self.mode[node as usize] = old,
-                Entry::Cost(c) => self.cost = c,
-            }
-        }
+        self.undo_to(0);
         self.saved.clear();
         self.journaling = false;
     }
