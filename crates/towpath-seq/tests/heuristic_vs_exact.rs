@@ -196,3 +196,45 @@ fn deterministic_under_work_budget() {
         assert_eq!(a.solution, b.solution, "{}", case.label);
     }
 }
+
+/// A few tasks with many modes each (a machining tool's cells with their entry points) are
+/// solved by the exact programme at once, with the programme's own optimum, instead of being
+/// searched for the whole time limit; beyond the work estimate they are searched.
+#[test]
+fn many_modes_on_few_tasks_are_solved_exactly() {
+    let mut rng = Pcg64Mcg::seed_from_u64(7);
+    let build = |n: usize, modes: usize, rng: &mut Pcg64Mcg| {
+        let mut pts: Vec<[f64; 3]> = vec![[0.0, 0.0, 0.0]];
+        let mut b_tasks = Vec::new();
+        for _ in 0..n {
+            let ms: Vec<Mode> = (0..modes)
+                .map(|_| {
+                    pts.push([rng.gen_range(0.0..500.0), rng.gen_range(0.0..300.0), 0.0]);
+                    Mode::point(StateId(pts.len() as u32 - 1))
+                })
+                .collect();
+            b_tasks.push(ms);
+        }
+        let mut b = Problem::builder(PointCost::new(pts, Metric::Euclidean));
+        for ms in b_tasks {
+            b.task(ms);
+        }
+        b.start(StateId(0));
+        b.end(End::At(StateId(0)));
+        b.build().unwrap()
+    };
+    let opts =
+        SolveOptions { time_limit: Some(std::time::Duration::from_secs(20)), threads: 1, ..SolveOptions::default() };
+    for (n, modes) in [(4, 16), (7, 16), (10, 16)] {
+        let p = build(n, modes, &mut rng);
+        let r = solve(&p, &opts).unwrap();
+        assert!(r.exact, "{n} tasks of {modes} modes were searched");
+        let best = solve_exact(&p).unwrap().unwrap();
+        assert!((r.solution.cost - best.cost).abs() < 1e-9, "{} against {}", r.solution.cost, best.cost);
+        assert!((check(&p, &r.solution.steps).unwrap() - best.cost).abs() < 1e-9);
+    }
+    // 2^10 · 10² · 24² is past the estimate: searched, under a small work budget here
+    let p = build(10, 24, &mut rng);
+    let r = solve(&p, &SolveOptions { iterations: Some(200), threads: 1, ..SolveOptions::default() }).unwrap();
+    assert!(!r.exact);
+}

@@ -95,8 +95,9 @@ pub struct SolveOptions {
     pub progress: Option<ProgressFn>,
     /// Set to true to stop the search early; the best route so far is returned.
     pub cancel: Option<Arc<AtomicBool>>,
-    /// Problems with at most this many tasks (and at most 6 modes per task) are solved exactly
-    /// by dynamic programming instead (default 10).
+    /// Problems with at most this many tasks are solved exactly by dynamic programming instead
+    /// (default 10), when their modes keep the programme small: 2ⁿ·n²·m² (times m on a closed
+    /// route) at most 3.2·10⁷ for n tasks of at most m modes.
     pub exact_up_to: usize,
     /// Stop when this many epochs in a row (a twentieth of the work budget each) have not
     /// improved the best route: the budget becomes an upper bound for small or easy problems.
@@ -367,10 +368,22 @@ fn search<C: CostModel>(
     })
 }
 
-/// The exact answer of a problem small enough for the dynamic programme (few tasks, at most
-/// six modes each), or `None` to search heuristically.
+/// Largest estimated work, 2ⁿ·n²·m² transitions (times m for a closed route, one programme
+/// per mode of its anchor), of a problem [`solve`] hands to the exact dynamic programme: ten
+/// tasks of sixteen modes each (2.6·10⁷, about a tenth of a second), such as a machining tool's
+/// cells with their entry points, are solved exactly at once instead of searched for the
+/// whole time limit.
+const EXACT_WORK: f64 = 3.2e7;
+
+/// The exact answer of a problem small enough for the dynamic programme (at most
+/// `opts.exact_up_to` tasks and [`EXACT_WORK`]), or `None` to search heuristically.
 fn small_exact<C: CostModel>(problem: &Problem<C>, opts: &SolveOptions) -> Result<Option<Solution>, SolveError> {
-    if problem.num_tasks() > opts.exact_up_to.min(crate::MAX_EXACT_TASKS) || problem.max_modes() > 6 {
+    let (n, m) = (problem.num_tasks(), problem.max_modes().max(1) as f64);
+    if n > opts.exact_up_to.min(crate::MAX_EXACT_TASKS) {
+        return Ok(None);
+    }
+    let anchors = if problem.is_cyclic() { m } else { 1.0 };
+    if 2f64.powi(n as i32) * (n * n) as f64 * m * m * anchors > EXACT_WORK {
         return Ok(None);
     }
     match solve_exact(problem) {

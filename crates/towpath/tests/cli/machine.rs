@@ -98,3 +98,49 @@ fn bad_parts_are_refused() {
     let (code, _, err) = run(towpath().args(["machine", dir.join("missing.json").to_str().unwrap()]));
     assert_eq!(code, 2, "{err}");
 }
+
+/// A tool's search stops before the time limit: small tools (here 7 and 4 cells of up to 16
+/// entries) are solved exactly at once, a larger one (25 cells) stops when its plan stops
+/// improving. Before, every tool took the whole limit.
+#[test]
+fn tools_do_not_wait_for_the_time_limit() {
+    let dir = scratch("machine-stall");
+    let small = dir.join("small.json");
+    std::fs::write(&small, PART).unwrap();
+    let limit = 6.0;
+    let args = |p: &std::path::Path| {
+        towpath_out(&["machine", p.to_str().unwrap(), "--time-limit", "6", "--threads", "1", "--json"])
+    };
+    let v = json_of(&args(&small));
+    for t in v["tools"].as_array().unwrap() {
+        assert!(t["solve_seconds"].as_f64().unwrap() < 1.0, "{t}");
+    }
+    // a face over 24 square pockets in a 4 × 6 grid: 25 cells for one tool
+    let pockets: Vec<String> = (0..24)
+        .map(|k| {
+            let (x, y) = (10 + 40 * (k % 6), 10 + 40 * (k / 6));
+            format!(
+                r#"{{"id": "p{k}", "parent": "face", "depth": 5, "boundary": [[{x},{y}],[{},{y}],[{},{}],[{x},{}]]}}"#,
+                x + 25,
+                x + 25,
+                y + 25,
+                y + 25
+            )
+        })
+        .collect();
+    let ids: Vec<String> = (0..24).map(|k| format!("\"p{k}\"")).collect();
+    let grid = format!(
+        r#"{{"format": "towpath-part/1", "name": "grid", "origin": [0, 0], "clearance": 5,
+ "features": [{{"id": "face", "boundary": [[0,0],[250,0],[250,170],[0,170]], "depth": 1}}, {}],
+ "tools": [{{"number": 1, "radius": 3, "step_over": 2, "features": ["face", {}]}}]}}"#,
+        pockets.join(", "),
+        ids.join(", ")
+    );
+    let part = dir.join("grid.json");
+    std::fs::write(&part, grid).unwrap();
+    let v = json_of(&args(&part));
+    let t = &v["tools"][0];
+    assert_eq!(t["cells"], 25);
+    assert!(t["solve_seconds"].as_f64().unwrap() < 0.75 * limit, "{t}");
+    assert!(v["rapid_after"].as_f64().unwrap() <= v["rapid_before"].as_f64().unwrap() + 1e-9);
+}
