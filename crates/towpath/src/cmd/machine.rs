@@ -52,8 +52,9 @@ pub struct Args {
     /// Write a drawing of the linked paths (.svg) or a report with it (.html).
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
-    /// Solver time limit per tool in seconds. The search stops sooner when a fifth of the
-    /// budget (four of its twenty epochs in a row) brings no better plan.
+    /// Solver time limit per tool in seconds. A tool of up to ten cells (of up to 16 entries
+    /// each) is linked exactly at once; a larger one stops sooner when 40 % of the budget
+    /// (eight of its twenty epochs in a row) brings no better plan.
     #[arg(long, default_value_t = 2.0)]
     pub time_limit: f64,
     /// Work budget per tool; without --time-limit the answer depends only on the input, seed
