@@ -15,6 +15,22 @@ const PART: &str = r#"{"format": "towpath-part/1", "name": "plate", "origin": [0
  "tools": [{"number": 1, "radius": 3, "step_over": 2, "features": ["face", "dumbbell", "ring"]},
            {"number": 2, "radius": 1, "step_over": 1.5, "features": ["slot", "ring"]}]}"#;
 
+/// `towpath machine PART --solver castelino --time-limit LIMIT --threads 1 --json`, parsed.
+fn castelino(part: &std::path::Path, limit: &str) -> serde_json::Value {
+    let o = towpath_out(&[
+        "machine",
+        part.to_str().unwrap(),
+        "--solver",
+        "castelino",
+        "--time-limit",
+        limit,
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    json_of(&o)
+}
+
 #[test]
 fn machines_a_part_and_the_gcode_keeps_the_hierarchy() {
     let dir = scratch("machine");
@@ -63,18 +79,7 @@ fn machines_a_part_and_the_gcode_keeps_the_hierarchy() {
     assert_eq!(*db[0], "dumbbella");
     assert!(v["rapid_after"].as_f64().unwrap() <= v["rapid_before"].as_f64().unwrap() + 1e-9);
     // Castelino's transformation plans the same part legally.
-    let o = towpath_out(&[
-        "machine",
-        part.to_str().unwrap(),
-        "--solver",
-        "castelino",
-        "--time-limit",
-        "1",
-        "--threads",
-        "1",
-        "--json",
-    ]);
-    let c = json_of(&o);
+    let c = castelino(&part, "1");
     assert_eq!(c["solver"], "castelino");
     assert_eq!(c["tools"][0]["cells"], v["tools"][0]["cells"]);
 }
@@ -107,9 +112,11 @@ fn tools_do_not_wait_for_the_time_limit() {
     let dir = scratch("machine-stall");
     let small = dir.join("small.json");
     std::fs::write(&small, PART).unwrap();
-    let limit = 6.0;
+    // (epochs of 0.5 s: the 25-cell tool stops 4 s after its last improvement, which comes
+    // within a second on a quiet machine and within a few on a loaded one)
+    let limit = 10.0;
     let args = |p: &std::path::Path| {
-        towpath_out(&["machine", p.to_str().unwrap(), "--time-limit", "6", "--threads", "1", "--json"])
+        towpath_out(&["machine", p.to_str().unwrap(), "--time-limit", "10", "--threads", "1", "--json"])
     };
     let v = json_of(&args(&small));
     for t in v["tools"].as_array().unwrap() {
@@ -141,23 +148,12 @@ fn tools_do_not_wait_for_the_time_limit() {
     let v = json_of(&args(&part));
     let t = &v["tools"][0];
     assert_eq!(t["cells"], 25);
-    assert!(t["solve_seconds"].as_f64().unwrap() < 0.75 * limit, "{t}");
+    assert!(t["solve_seconds"].as_f64().unwrap() < 0.9 * limit, "{t}");
     assert!(v["rapid_after"].as_f64().unwrap() <= v["rapid_before"].as_f64().unwrap() + 1e-9);
     // Castelino's 800-node transformation, whose local search steps take milliseconds each,
     // keeps a short limit too (it ran 1.5 s at a 0.5 s limit when the local search looked at
     // the clock every 256 steps).
-    let o = towpath_out(&[
-        "machine",
-        part.to_str().unwrap(),
-        "--solver",
-        "castelino",
-        "--time-limit",
-        "0.5",
-        "--threads",
-        "1",
-        "--json",
-    ]);
-    let c = json_of(&o);
+    let c = castelino(&part, "0.5");
     let secs = c["tools"][0]["solve_seconds"].as_f64().unwrap();
     assert!(secs < 1.0, "castelino took {secs} s at a 0.5 s limit");
 }
