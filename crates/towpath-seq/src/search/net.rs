@@ -551,7 +551,7 @@ mod tests {
             assert_eq!(net.dense_w, if open { s } else { s - 1 });
             for a in 0..net.n as u32 {
                 for b in 0..net.n as u32 {
-                    let want = net.raw_arc(a, 0, b, 0).min(net.forbidden).max(-net.forbidden);
+                    let want = net.priced(net.raw_arc(a, 0, b, 0));
                     assert_eq!(net.arc(a, 0, b, 0), want, "open {open}: arc {a} -> {b}");
                 }
             }
