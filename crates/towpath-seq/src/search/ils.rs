@@ -58,6 +58,9 @@ pub(crate) struct Chain {
     /// that leaves its basin often, which pays on clustered geometry (whole clusters in the
     /// wrong order), where the other chains keep deepening.
     pub restless: bool,
+    /// Builds a start of its own (see [`Ils::fresh_start`]) before its first kick: a chain of
+    /// the population (see `population`).
+    pub fresh: bool,
 }
 
 impl Chain {
@@ -68,6 +71,7 @@ impl Chain {
             rng: Pcg64Mcg::seed_from_u64(seed),
             stagnation: 0,
             restless: false,
+            fresh: false,
         }
     }
 
@@ -144,6 +148,53 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         ls.moves
     }
 
+    /// A start of its own for a chain of a plain tour: nearest neighbour from a random first
+    /// node, looking only at candidate neighbours while one is unvisited (else at every
+    /// unvisited node), brought to a local optimum.
+    pub fn fresh_start(&self, rng: &mut Pcg64Mcg, deadline: Option<Instant>) -> Tour {
+        let net = self.net;
+        let n = net.n;
+        let mut left: Vec<u32> = (0..n as u32).collect();
+        let mut at: Vec<u32> = (0..n as u32).collect();
+        let mut seq = Vec::with_capacity(n);
+        let take = |left: &mut Vec<u32>, at: &mut Vec<u32>, v: u32| {
+            let i = at[v as usize] as usize;
+            let last = *left.last().expect("v is left");
+            left.swap_remove(i);
+            at[last as usize] = i as u32;
+            at[v as usize] = u32::MAX;
+        };
+        let mut cur = rng.gen_range(0..n as u32);
+        take(&mut left, &mut at, cur);
+        seq.push(cur);
+        while !left.is_empty() {
+            let mut best = (Cost::INFINITY, u32::MAX);
+            for &u in self.nb.out(cur) {
+                if at[u as usize] != u32::MAX {
+                    let c = net.arc(cur, 0, u, 0);
+                    if c < best.0 {
+                        best = (c, u);
+                    }
+                }
+            }
+            if best.1 == u32::MAX {
+                for &u in &left {
+                    let c = net.arc(cur, 0, u, 0);
+                    if best.1 == u32::MAX || c < best.0 {
+                        best = (c, u);
+                    }
+                }
+            }
+            cur = best.1;
+            take(&mut left, &mut at, cur);
+            seq.push(cur);
+        }
+        super::construct::rotate_to_anchor(net, &mut seq);
+        let mut tour = Tour::new(net, seq, vec![0; n]);
+        self.descend(&mut tour, deadline);
+        tour
+    }
+
     /// Brings a tour back to a local optimum after changes at `nodes` (only those are looked
     /// at first). Returns false when the deadline cut the search short.
     pub fn polish(&self, tour: &mut Tour, nodes: &[u32], deadline: Option<Instant>) -> bool {
@@ -158,7 +209,7 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
 
     /// Runs kicks on a chain's state and returns the kicks done.
     pub fn run(&self, state: &mut Chain, budget: Budget, cancel: Option<&AtomicBool>) -> u64 {
-        let Chain { cur, best, rng, stagnation, restless } = state;
+        let Chain { cur, best, rng, stagnation, restless, .. } = state;
         let restart_after = if *restless { RESTLESS_AFTER * cur.len() as u64 + 200 } else { self.restart_after };
         let mut ls = LocalSearch::new(self.net, self.nb, self.eps);
         ls.deadline = budget.hard;

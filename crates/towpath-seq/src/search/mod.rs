@@ -11,6 +11,7 @@ mod modes;
 mod neighbors;
 mod net;
 mod patching;
+mod population;
 mod reversible;
 mod sop3;
 mod tour;
@@ -577,7 +578,7 @@ fn search_epochs<C: CostModel>(
     let mut iterations = 0u64;
     let mut stalled = 0u32;
     let total_kicks = opts.iterations.unwrap_or(u64::MAX);
-    let epochs_planned = 20u64;
+    let epochs_planned = EPOCHS_PLANNED as u64;
     let per_epoch = match opts.iterations {
         Some(it) => (it / (epochs_planned * threads as u64)).max(1),
         None => u64::MAX,
@@ -593,11 +594,16 @@ fn search_epochs<C: CostModel>(
         d - reserve
     });
     let merge_chains = threads > 1 && local::uses_or3(net);
-    let mut chains: Vec<ils::Chain> = (0..threads)
+    // On plain tours, a population of chains from starts of their own for the first epochs
+    // (see `population`), where the budget allows it.
+    let per_thread = population::chains_per_thread(net, opts, threads);
+    let mut population_epochs = if per_thread > 1 { population::EPOCHS } else { 0 };
+    let mut chains: Vec<ils::Chain> = (0..threads * per_thread)
         .map(|t| {
             let mut chain = ils::Chain::new(best, opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ t as u64);
             // a portfolio on plain tours: every second chain restarts often (clustered geometry)
             chain.restless = t % 2 == 1 && local::uses_or3(net);
+            chain.fresh = t > 0 && per_thread > 1;
             chain
         })
         .collect();
@@ -615,22 +621,37 @@ fn search_epochs<C: CostModel>(
         let temperature = acceptance_temperature(net, best.cost, frac);
         let budget = Budget { kicks: kicks_each, deadline: epoch_deadline, hard: search_end, temperature };
         let cancel = clock.cancel_flag().map(|c| &**c);
+        let group = chains.len() / threads;
         let done: u64 = if threads == 1 {
-            ils.run(&mut chains[0], budget, cancel)
+            population::run_thread(ils, &mut chains, budget, slice, cancel)
         } else {
             std::thread::scope(|s| {
                 let handles: Vec<_> = chains
-                    .iter_mut()
-                    .map(|chain| {
+                    .chunks_mut(group)
+                    .map(|chains| {
                         let ils = &ils;
-                        s.spawn(move || ils.run(chain, budget, cancel))
+                        s.spawn(move || population::run_thread(ils, chains, budget, slice, cancel))
                     })
                     .collect();
                 handles.into_iter().map(|h| h.join().expect("solver thread panicked")).sum()
             })
         };
         let before = best.cost;
-        share_best(net, ils, best, &mut chains, merge_chains, search_end, eps);
+        if population_epochs > 1 {
+            // the population: the chains keep their own tours
+            population_epochs -= 1;
+            for c in &chains {
+                if c.best.cost < best.cost - eps {
+                    best.clone_from(&c.best);
+                }
+            }
+        } else {
+            if population_epochs == 1 {
+                population_epochs = 0;
+                population::merge_all(net, ils, best, &mut chains, threads, search_end, eps);
+            }
+            share_best(net, ils, best, &mut chains, merge_chains, search_end, eps);
+        }
         iterations += done;
         stalled = if best.cost < before - eps { 0 } else { stalled + 1 };
         if opts.stall_epochs.is_some_and(|k| stalled >= k) {
@@ -646,6 +667,10 @@ fn search_epochs<C: CostModel>(
     }
     iterations
 }
+
+/// Epochs a search plans: its budget is spent in this many rounds of kicks (fewer when a time
+/// limit makes an epoch longer than 2 s), each ending with the chains sharing their best.
+const EPOCHS_PLANNED: usize = 20;
 
 /// The end of an epoch: the best chain wins (lowest index on ties); where the chains' tours can
 /// be merged, the merge keeps every chain's improvements instead of only the best chain's; chains
