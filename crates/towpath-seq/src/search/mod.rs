@@ -653,7 +653,8 @@ fn search_epochs<C: CostModel>(
             share_best(net, ils, best, &mut chains, merge_chains, search_end, eps);
         }
         iterations += done;
-        stalled = if best.cost < before - eps { 0 } else { stalled + 1 };
+        // (a population is not stalled before its merge)
+        stalled = if best.cost < before - eps || population_epochs > 0 { 0 } else { stalled + 1 };
         if opts.stall_epochs.is_some_and(|k| stalled >= k) {
             break;
         }
