@@ -640,11 +640,7 @@ fn search_epochs<C: CostModel>(
         if population_epochs > 1 {
             // the population: the chains keep their own tours
             population_epochs -= 1;
-            for c in &chains {
-                if c.best.cost < best.cost - eps {
-                    best.clone_from(&c.best);
-                }
-            }
+            take_cheapest(best, &chains, eps);
         } else {
             if population_epochs == 1 {
                 population_epochs = 0;
@@ -685,24 +681,42 @@ fn share_best<C: CostModel>(
     search_end: Option<Instant>,
     eps: Cost,
 ) {
-    for c in chains.iter() {
-        if c.best.cost < best.cost - eps {
-            best.clone_from(&c.best);
-        }
-    }
+    take_cheapest(best, chains, eps);
     if merge_chains {
-        for c in chains.iter() {
-            if let Some((seq, changed)) = merge::partition_crossover(net, best, &c.best, eps) {
-                let mut child = Tour::new(net, seq, vec![0; net.n]);
-                if ils.polish(&mut child, &changed, search_end) && child.cost < best.cost - eps {
-                    *best = child;
-                }
-            }
-        }
+        merge_into_best(net, ils, best, chains, search_end, eps);
     }
     for c in chains.iter_mut() {
         if c.best.cost > best.cost + eps {
             c.adopt(best);
+        }
+    }
+}
+
+/// Makes `best` the cheapest chain's best tour where that is cheaper (the lowest index on ties).
+fn take_cheapest(best: &mut Tour, chains: &[ils::Chain], eps: Cost) {
+    for c in chains {
+        if c.best.cost < best.cost - eps {
+            best.clone_from(&c.best);
+        }
+    }
+}
+
+/// Merges each chain's best tour into `best` in turn by partition crossover (plain symmetric
+/// one-mode tours), each merge polished by the local search and kept when cheaper.
+fn merge_into_best<C: CostModel>(
+    net: &Net<C>,
+    ils: &Ils<'_, '_, C>,
+    best: &mut Tour,
+    chains: &[ils::Chain],
+    search_end: Option<Instant>,
+    eps: Cost,
+) {
+    for c in chains {
+        if let Some((seq, changed)) = merge::partition_crossover(net, best, &c.best, eps) {
+            let mut child = Tour::new(net, seq, vec![0; net.n]);
+            if ils.polish(&mut child, &changed, search_end) && child.cost < best.cost - eps {
+                *best = child;
+            }
         }
     }
 }

@@ -5,7 +5,7 @@
 //!
 //! Why: on clustered points one run of the iterated local search settles in the funnel of its
 //! start, where the clusters are entered and left in one way across the whole tour, and its
-//! kicks do not leave it (gauss-5000-60 ended anywhere from 1,093,822 to 1,105,997 over 14
+//! kicks do not leave it (gauss-5000-60 ended anywhere from 1,093,822 to 1,103,349 over 14
 //! seeds of one start). Local optima from different starts differ in many independent
 //! components, and the merge takes the best of each (Whitley, Hains and Howe 2009 found the
 //! same for partition crossover of Lin–Kernighan optima).
@@ -15,7 +15,6 @@ use std::time::{Duration, Instant};
 
 use super::ils::{Budget, Chain, Ils};
 use super::local;
-use super::merge;
 use super::net::Net;
 use super::tour::Tour;
 use crate::cost::{Cost, CostModel};
@@ -97,18 +96,9 @@ pub(crate) fn merge_all<C: CostModel>(
     eps: Cost,
 ) {
     chains.sort_by(|a, b| a.best.cost.total_cmp(&b.best.cost));
-    if chains[0].best.cost < best.cost - eps {
-        best.clone_from(&chains[0].best);
-    }
+    super::take_cheapest(best, chains, eps);
     for _round in 0..2 {
-        for c in chains.iter() {
-            if let Some((seq, changed)) = merge::partition_crossover(net, best, &c.best, eps) {
-                let mut child = Tour::new(net, seq, vec![0; net.n]);
-                if ils.polish(&mut child, &changed, search_end) && child.cost < best.cost - eps {
-                    *best = child;
-                }
-            }
-        }
+        super::merge_into_best(net, ils, best, chains, search_end, eps);
     }
     chains.truncate(threads);
     for (t, c) in chains.iter_mut().enumerate() {
