@@ -98,6 +98,10 @@ pub(crate) struct Budget {
     /// Acceptance temperature: a kick that makes the tour dearer by Δ is kept with probability
     /// exp(-Δ / temperature) (0: only kicks that do not make it dearer).
     pub temperature: Cost,
+    /// First-level moves a 3-opt chain backtracks over (see [`SolveOptions::lk_breadth`]).
+    ///
+    /// [`SolveOptions::lk_breadth`]: crate::SolveOptions::lk_breadth
+    pub breadth1: usize,
 }
 
 pub(crate) struct Ils<'a, 'p, C> {
@@ -213,6 +217,7 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         let restart_after = if *restless { RESTLESS_AFTER * cur.len() as u64 + 200 } else { self.restart_after };
         let mut ls = LocalSearch::new(self.net, self.nb, self.eps);
         ls.deadline = budget.hard;
+        ls.breadth1 = budget.breadth1;
         let n = cur.len();
         let long_bridges = *restless && self.bridge4 && n <= LONG_BRIDGE_UP_TO;
         let mut kicks = 0u64;

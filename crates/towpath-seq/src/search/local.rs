@@ -15,7 +15,7 @@ use super::sop3::{self, Sop3};
 use super::tour::Tour;
 use crate::cost::{Cost, CostModel};
 
-mod lk3;
+pub(crate) mod lk3;
 
 /// Longest segment Or-opt moves.
 const MAX_SEGMENT: usize = 3;
@@ -103,6 +103,8 @@ pub(crate) struct LocalSearch<'a, 'p, C> {
     /// Arcs the current chain of 3-opt moves added and removed.
     lk3_added: Vec<(u32, u32)>,
     lk3_removed: Vec<(u32, u32)>,
+    /// First-level moves a 3-opt chain backtracks over.
+    pub breadth1: usize,
     /// The exhaustive SOP-3-exchange, where it applies (see `sop3::applies`).
     sop3: Option<Sop3>,
 }
@@ -164,6 +166,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             lk3: or3,
             lk3_added: Vec::new(),
             lk3_removed: Vec::new(),
+            breadth1: 1,
             sop3: sop3::applies(net).then(|| Sop3::new(net.n)),
         }
     }

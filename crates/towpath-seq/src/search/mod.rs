@@ -119,6 +119,12 @@ pub struct SolveOptions {
     /// O(n²) arc evaluations on top of the time limit (about 1 s at 5,000 nodes, 13 s at
     /// 20,000); default false.
     pub held_karp_bound: bool,
+    /// On plain symmetric tours, how many first-level 3-opt moves a Lin–Kernighan chain tries
+    /// in turn (backtracking, as LKH does) before it gives up, 1 to 4. `None` (default): 2
+    /// where the budget allows about [`BREADTH_KICKS_PER_NODE`] kicks per node (at 10 s on 2
+    /// threads, up to about 5,000 nodes), else 1: a second try halves the kick rate, which pays
+    /// only where the search has kicks to spare.
+    pub lk_breadth: Option<usize>,
 }
 
 impl Default for SolveOptions {
@@ -136,6 +142,7 @@ impl Default for SolveOptions {
             assignment_branching: true,
             two_way_ends: true,
             held_karp_bound: false,
+            lk_breadth: None,
         }
     }
 }
@@ -153,6 +160,7 @@ impl std::fmt::Debug for SolveOptions {
             .field("assignment_branching", &self.assignment_branching)
             .field("two_way_ends", &self.two_way_ends)
             .field("held_karp_bound", &self.held_karp_bound)
+            .field("lk_breadth", &self.lk_breadth)
             .finish()
     }
 }
@@ -594,6 +602,7 @@ fn search_epochs<C: CostModel>(
         d - reserve
     });
     let merge_chains = threads > 1 && local::uses_or3(net);
+    let breadth1 = lk_breadth(net, opts, threads);
     // On plain tours, a population of chains from starts of their own for the first epochs
     // (see `population`), where the budget allows it.
     let per_thread = population::chains_per_thread(net, opts, threads);
@@ -619,7 +628,7 @@ fn search_epochs<C: CostModel>(
         let kicks_each = per_epoch.min(left.div_ceil(threads as u64));
         let frac = budget_used(opts, t0, iterations).unwrap_or(1.0);
         let temperature = acceptance_temperature(net, best.cost, frac);
-        let budget = Budget { kicks: kicks_each, deadline: epoch_deadline, hard: search_end, temperature };
+        let budget = Budget { kicks: kicks_each, deadline: epoch_deadline, hard: search_end, temperature, breadth1 };
         let cancel = clock.cancel_flag().map(|c| &**c);
         let group = chains.len() / threads;
         let done: u64 = if threads == 1 {
@@ -663,6 +672,35 @@ fn search_epochs<C: CostModel>(
         }
     }
     iterations
+}
+
+/// Kicks per node a budget must allow for chains to backtrack over two first-level moves (see
+/// [`SolveOptions::lk_breadth`]). On clustered and TSPLIB instances at 10 s on 2 threads
+/// (medians of 3-12 seeds), breadth 2 gained where 1 gave 20-50 kicks per node (portc 2,000 and
+/// 5,000, pcb3038), was neutral or lost within the spread at 7-40 (fnl4461, Gaussian clusters of
+/// 2,000-10,000 points, portc 10,000).
+pub const BREADTH_KICKS_PER_NODE: f64 = 40.0;
+
+/// Time one kick takes on one thread, for turning a time limit into kicks (about 10,000 a
+/// second on fnl4461; see `bench/kick_rate.py`).
+const KICK_SECONDS: f64 = 100e-6;
+
+/// The first-level breadth of 3-opt chains: as asked, else by the budget's kicks per node.
+fn lk_breadth<C: CostModel>(net: &Net<C>, opts: &SolveOptions, threads: usize) -> usize {
+    if let Some(b) = opts.lk_breadth {
+        return b.clamp(1, local::lk3::MAX_BREADTH1);
+    }
+    let n = net.n.max(1) as f64;
+    let per_node = match (opts.iterations, opts.time_limit) {
+        (Some(it), _) => it as f64 / n,
+        (None, Some(tl)) => tl.as_secs_f64() * threads as f64 / KICK_SECONDS / n,
+        (None, None) => 0.0,
+    };
+    if per_node >= BREADTH_KICKS_PER_NODE {
+        2
+    } else {
+        1
+    }
 }
 
 /// Epochs a search plans: its budget is spent in this many rounds of kicks (fewer when a time
@@ -810,3 +848,56 @@ const AP_BRANCH_MAX: Duration = Duration::from_secs(5);
 
 /// Branch-and-bound nodes per tour node when no time limit is set.
 const AP_BRANCH_NODES_PER_NODE: u64 = 20;
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+    use rand_pcg::Pcg64Mcg;
+
+    use super::testing::random_tour_problem;
+    use super::*;
+
+    /// Chains backtrack over two first-level moves only where the budget gives about 40 kicks a
+    /// node; an explicit breadth is kept within 1..=4.
+    #[test]
+    fn lk_breadth_follows_the_budget() {
+        let p = random_tour_problem(&mut Pcg64Mcg::seed_from_u64(1), 500, 1000.0);
+        let net = Net::new(&p);
+        let worked = |it: u64| SolveOptions { time_limit: None, iterations: Some(it), ..Default::default() };
+        let at = (BREADTH_KICKS_PER_NODE * net.n as f64).ceil() as u64;
+        assert_eq!(lk_breadth(&net, &worked(at), 2), 2);
+        assert_eq!(lk_breadth(&net, &worked(at - 1), 2), 1);
+        // 10 s on 2 threads: 200,000 kicks, 2 at 5,000 nodes and below, 1 above
+        let timed = |secs: f64| SolveOptions { time_limit: Some(Duration::from_secs_f64(secs)), ..Default::default() };
+        let limit = |n: usize| 10.0 * 2.0 / KICK_SECONDS / BREADTH_KICKS_PER_NODE >= n as f64;
+        assert!(limit(5000) && !limit(5001));
+        assert_eq!(lk_breadth(&net, &timed(10.0), 2), 2);
+        assert_eq!(lk_breadth(&net, &timed(0.01), 2), 1);
+        for (asked, got) in [(0, 1), (1, 1), (3, 3), (9, local::lk3::MAX_BREADTH1)] {
+            let opts = SolveOptions { lk_breadth: Some(asked), ..timed(0.01) };
+            assert_eq!(lk_breadth(&net, &opts, 2), got);
+        }
+    }
+
+    /// Every breadth gives a deterministic solve under a work budget whose route the checker
+    /// agrees with.
+    #[test]
+    fn solves_at_every_breadth_are_deterministic_and_checked() {
+        let p = random_tour_problem(&mut Pcg64Mcg::seed_from_u64(7), 120, 1000.0);
+        for breadth in 1..=local::lk3::MAX_BREADTH1 {
+            let opts = SolveOptions {
+                time_limit: None,
+                iterations: Some(3_000),
+                threads: 2,
+                seed: 3,
+                lk_breadth: Some(breadth),
+                ..Default::default()
+            };
+            let a = solve(&p, &opts).expect("solves");
+            let b = solve(&p, &opts).expect("solves");
+            assert_eq!(a.solution.steps, b.solution.steps, "breadth {breadth}");
+            let cost = check(&p, &a.solution.steps).expect("feasible");
+            assert!((cost - a.solution.cost).abs() < 1e-6 * cost, "breadth {breadth}");
+        }
+    }
+}

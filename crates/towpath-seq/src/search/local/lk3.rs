@@ -6,7 +6,9 @@
 //! t2–t3, t4–t5 leaves a Hamiltonian path from t1 to t6. Any closing by t6–t1 (or, when t4 lies
 //! on the 2-opt side, t4–t1 at once) that gains is applied at once; otherwise the 3-opt move of
 //! the largest partial gain G4 is applied tentatively and the chain goes on from t6. An arc the
-//! chain removed is never added back and an arc it added is never removed.
+//! chain removed is never added back and an arc it added is never removed. When a chain
+//! fails, it starts again from the next-best first-level moves in turn, up to `breadth1` in all
+//! (LKH's backtracking, here at the first level only).
 
 use super::LocalSearch;
 use crate::cost::{Cost, CostModel};
@@ -21,6 +23,11 @@ const T5_BREADTH: usize = 5;
 
 /// No node.
 const NONE: u32 = u32::MAX;
+
+/// Most first-level moves a chain backtracks over (see [`SolveOptions::lk_breadth`]).
+///
+/// [`SolveOptions::lk_breadth`]: crate::SolveOptions::lk_breadth
+pub(crate) const MAX_BREADTH1: usize = 4;
 
 /// How a level's 3-opt move reconnects the tour.
 #[derive(Clone, Copy)]
@@ -47,8 +54,9 @@ struct Move {
 enum Level {
     /// An improving move was applied; the tour's cost falls by this gain.
     Improved(Cost),
-    /// No closing gains; the best continuation.
-    Deeper(Move),
+    /// No closing gains; the best continuations, largest partial gain first (the first always
+    /// present).
+    Deeper([Option<Move>; MAX_BREADTH1]),
     /// Nothing to close or continue with.
     Stuck,
 }
@@ -77,6 +85,7 @@ impl<C: CostModel> LocalSearch<'_, '_, C> {
         }
         let cost0 = tour.cost;
         let mut improved = false;
+        let breadth = self.breadth1.clamp(1, MAX_BREADTH1);
         'dirs: for forward in [true, false] {
             let start = tour.mark();
             let first = if forward { tour.next(t1) } else { tour.prev(t1) };
@@ -84,25 +93,39 @@ impl<C: CostModel> LocalSearch<'_, '_, C> {
             self.lk3_added.clear();
             self.lk3_removed.clear();
             self.lk3_removed.push(key(t1, first));
-            let mut t2 = first;
-            let mut g = self.net.arc(t1, 0, t2, 0);
-            for _ in 0..DEPTH {
-                match self.lk3_level(tour, t1, t2, g) {
-                    Level::Improved(gain) => {
-                        tour.cost = cost0 - gain;
-                        improved = true;
-                        break 'dirs;
+            let g0 = self.net.arc(t1, 0, first, 0);
+            let alts = match self.lk3_level(tour, t1, first, g0, breadth) {
+                Level::Improved(gain) => {
+                    tour.cost = cost0 - gain;
+                    improved = true;
+                    break 'dirs;
+                }
+                Level::Deeper(alts) => alts,
+                Level::Stuck => continue,
+            };
+            for m in alts.into_iter().flatten() {
+                tour.undo_to(start);
+                self.lk3_added.clear();
+                self.lk3_removed.truncate(1);
+                self.lk3_apply(tour, t1, first, &m);
+                self.lk3_push(first, &m);
+                let mut t2 = m.t6;
+                let mut g = m.g4;
+                for _ in 1..DEPTH {
+                    match self.lk3_level(tour, t1, t2, g, 1) {
+                        Level::Improved(gain) => {
+                            tour.cost = cost0 - gain;
+                            improved = true;
+                            break 'dirs;
+                        }
+                        Level::Deeper([Some(m), ..]) => {
+                            self.lk3_apply(tour, t1, t2, &m);
+                            self.lk3_push(t2, &m);
+                            t2 = m.t6;
+                            g = m.g4;
+                        }
+                        _ => break,
                     }
-                    Level::Deeper(m) => {
-                        self.lk3_apply(tour, t1, t2, &m);
-                        self.lk3_added.push(key(t2, m.t3));
-                        self.lk3_added.push(key(m.t4, m.t5));
-                        self.lk3_removed.push(key(m.t3, m.t4));
-                        self.lk3_removed.push(key(m.t5, m.t6));
-                        t2 = m.t6;
-                        g = m.g4;
-                    }
-                    Level::Stuck => break,
                 }
             }
             tour.undo_to(start);
@@ -110,9 +133,17 @@ impl<C: CostModel> LocalSearch<'_, '_, C> {
         self.end_chain(tour, improved, own_journal)
     }
 
+    /// Notes the arcs a level's move added and removed.
+    fn lk3_push(&mut self, t2: u32, m: &Move) {
+        self.lk3_added.push(key(t2, m.t3));
+        self.lk3_added.push(key(m.t4, m.t5));
+        self.lk3_removed.push(key(m.t3, m.t4));
+        self.lk3_removed.push(key(m.t5, m.t6));
+    }
+
     /// One level from the open arc t1–t2 with partial gain `g` (the cost of the arcs removed
-    /// less that of the arcs added so far, t1–t2 included).
-    fn lk3_level(&mut self, tour: &mut Tour, t1: u32, t2: u32, g: Cost) -> Level {
+    /// less that of the arcs added so far, t1–t2 included); keeps the `keep` best continuations.
+    fn lk3_level(&mut self, tour: &mut Tour, t1: u32, t2: u32, g: Cost, keep: usize) -> Level {
         let net = self.net;
         let nb = self.nb;
         let eps = self.eps;
@@ -134,7 +165,7 @@ impl<C: CostModel> LocalSearch<'_, '_, C> {
             }
         };
         let succ2 = succ(tour, t2);
-        let mut best: Option<Move> = None;
+        let mut best: [Option<Move>; MAX_BREADTH1] = [None; MAX_BREADTH1];
         for (&t3, &c23) in nb.out(t2).iter().zip(nb.out_lb(t2)) {
             let g1 = g - c23;
             if g1 <= eps {
@@ -196,7 +227,7 @@ impl<C: CostModel> LocalSearch<'_, '_, C> {
                             self.lk3_apply(tour, t1, t2, &m);
                             return Level::Improved(gain);
                         }
-                        if best.is_some_and(|b| g4 <= b.g4) {
+                        if best[keep - 1].is_some_and(|b| g4 <= b.g4) {
                             continue;
                         }
                         // no t7 could keep the gain positive
@@ -210,14 +241,21 @@ impl<C: CostModel> LocalSearch<'_, '_, C> {
                         {
                             continue;
                         }
-                        best = Some(m);
+                        // keep the list in order of g4, largest first, dropping the last
+                        let mut at = keep - 1;
+                        while at > 0 && best[at - 1].is_none_or(|b| b.g4 < g4) {
+                            best[at] = best[at - 1];
+                            at -= 1;
+                        }
+                        best[at] = Some(m);
                     }
                 }
             }
         }
-        match best {
-            Some(m) => Level::Deeper(m),
-            None => Level::Stuck,
+        if best[0].is_some() {
+            Level::Deeper(best)
+        } else {
+            Level::Stuck
         }
     }
 
@@ -332,23 +370,26 @@ mod tests {
         assert!(checked[0] > 200 && checked[1] > 200, "{checked:?}");
     }
 
-    /// Chains improve by exactly what they claim, and once no chain from any node improves, no
-    /// 2-opt move does either (every node a candidate of every other, checked by brute force).
+    /// Chains improve by exactly what they claim and leave the tour as it was when they do not,
+    /// and once no chain from any node improves, no 2-opt move does either (every node a
+    /// candidate of every other, checked by brute force): at every first-level breadth.
     #[test]
     fn chains_gain_what_they_claim_and_end_two_opt_optimal() {
-        for seed in 0..6 {
+        for (seed, breadth) in (0..12).map(|s| (s, 1 + s as usize % MAX_BREADTH1)) {
             let n = 60;
             let mut rng = Pcg64Mcg::seed_from_u64(seed);
             let p = random_tour_problem(&mut rng, n, 1000.0);
             let net = Net::new(&p);
             let nb = Neighbors::build(&net, n - 1);
             let mut ls = LocalSearch::new(&net, &nb, 1e-9);
+            ls.breadth1 = breadth;
             let mut tour = Tour::new(&net, shuffled(&mut rng, n), vec![0; n]);
             let mut moves = 0;
             loop {
                 let mut any = false;
                 for t1 in 0..n as u32 {
                     let before = tour.cost;
+                    let seq_before = tour.seq.clone();
                     if ls.try_lk3(&mut tour, t1) {
                         any = true;
                         moves += 1;
@@ -357,6 +398,7 @@ mod tests {
                         assert!(full < before - 1e-9, "seed {seed}: no gain");
                     } else {
                         assert_eq!(tour.cost, before);
+                        assert_eq!(tour.seq, seq_before, "seed {seed}: a failed chain changed the tour");
                     }
                 }
                 if !any {
