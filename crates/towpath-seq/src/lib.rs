@@ -43,7 +43,7 @@ pub use exact::{solve_exact, ExactError, MAX_EXACT_TASKS};
 pub use model::{End, Mode, ModelError, Problem, ProblemBuilder, TaskId};
 pub use precedence::Precedence;
 pub use search::{
-    solve, solve_reversible, Progress, ProgressFn, SolveError, SolveOptions, SolveReport, BREADTH_KICKS_PER_NODE,
-    MAX_REVERSIBLE_TASKS, MAX_THREADS,
+    solve, solve_reversible, Progress, ProgressFn, SolveError, SolveOptions, SolveReport, BREADTH3_KICKS_PER_NODE,
+    BREADTH_KICKS_PER_NODE, MAX_REVERSIBLE_TASKS, MAX_THREADS,
 };
 pub use solution::{check, Solution, Step, Violation};

@@ -120,10 +120,11 @@ pub struct SolveOptions {
     /// 20,000); default false.
     pub held_karp_bound: bool,
     /// On plain symmetric tours, how many first-level 3-opt moves a Lin–Kernighan chain tries
-    /// in turn (backtracking, as LKH does) before it gives up, 1 to 4. `None` (default): 2
-    /// where the budget allows about [`BREADTH_KICKS_PER_NODE`] kicks per node (at 10 s on 2
-    /// threads, up to about 5,000 nodes), else 1: a second try halves the kick rate, which pays
-    /// only where the search has kicks to spare.
+    /// in turn (backtracking, as LKH does) before it gives up, 1 to 4. `None` (default): by the
+    /// budget's kicks per node, 3 from [`BREADTH3_KICKS_PER_NODE`], 2 from
+    /// [`BREADTH_KICKS_PER_NODE`] (at 10 s on 2 threads: up to 1,000 and 5,000 nodes), else 1:
+    /// each further try costs about as much as the first, which pays only where the search has
+    /// kicks to spare.
     pub lk_breadth: Option<usize>,
 }
 
@@ -681,6 +682,11 @@ fn search_epochs<C: CostModel>(
 /// 2,000-10,000 points, portc 10,000).
 pub const BREADTH_KICKS_PER_NODE: f64 = 40.0;
 
+/// Kicks per node a budget must allow for chains to backtrack over three first-level moves:
+/// on portc-2000 three lost to two at 10 s (100 per node as [`SolveOptions::lk_breadth`]
+/// counts them) and gained at 30 s (300), as on portc-5000 at 68 s (272; 3 seeds each).
+pub const BREADTH3_KICKS_PER_NODE: f64 = 200.0;
+
 /// Time one kick takes on one thread, for turning a time limit into kicks (about 10,000 a
 /// second on fnl4461; see `bench/kick_rate.py`).
 const KICK_SECONDS: f64 = 100e-6;
@@ -696,7 +702,9 @@ fn lk_breadth<C: CostModel>(net: &Net<C>, opts: &SolveOptions, threads: usize) -
         (None, Some(tl)) => tl.as_secs_f64() * threads as f64 / KICK_SECONDS / n,
         (None, None) => 0.0,
     };
-    if per_node >= BREADTH_KICKS_PER_NODE {
+    if per_node >= BREADTH3_KICKS_PER_NODE {
+        3
+    } else if per_node >= BREADTH_KICKS_PER_NODE {
         2
     } else {
         1
@@ -858,7 +866,7 @@ mod tests {
     use super::*;
 
     /// Chains backtrack over two first-level moves only where the budget gives about 40 kicks a
-    /// node; an explicit breadth is kept within 1..=4.
+    /// node, over three from 200; an explicit breadth is kept within 1..=4.
     #[test]
     fn lk_breadth_follows_the_budget() {
         let p = random_tour_problem(&mut Pcg64Mcg::seed_from_u64(1), 500, 1000.0);
@@ -867,11 +875,16 @@ mod tests {
         let at = (BREADTH_KICKS_PER_NODE * net.n as f64).ceil() as u64;
         assert_eq!(lk_breadth(&net, &worked(at), 2), 2);
         assert_eq!(lk_breadth(&net, &worked(at - 1), 2), 1);
-        // 10 s on 2 threads: 200,000 kicks, 2 at 5,000 nodes and below, 1 above
+        let at3 = (BREADTH3_KICKS_PER_NODE * net.n as f64).ceil() as u64;
+        assert_eq!(lk_breadth(&net, &worked(at3 - 1), 2), 2);
+        assert_eq!(lk_breadth(&net, &worked(at3), 2), 3);
+        // 10 s on 2 threads: 200,000 kicks, 3 at 1,000 nodes and below, 2 at 5,000 and below
         let timed = |secs: f64| SolveOptions { time_limit: Some(Duration::from_secs_f64(secs)), ..Default::default() };
-        let limit = |n: usize| 10.0 * 2.0 / KICK_SECONDS / BREADTH_KICKS_PER_NODE >= n as f64;
-        assert!(limit(5000) && !limit(5001));
-        assert_eq!(lk_breadth(&net, &timed(10.0), 2), 2);
+        let limit = |n: usize, per: f64| 10.0 * 2.0 / KICK_SECONDS / per >= n as f64;
+        assert!(limit(5000, BREADTH_KICKS_PER_NODE) && !limit(5001, BREADTH_KICKS_PER_NODE));
+        assert!(limit(1000, BREADTH3_KICKS_PER_NODE) && !limit(1001, BREADTH3_KICKS_PER_NODE));
+        assert_eq!(lk_breadth(&net, &timed(10.0), 2), 3);
+        assert_eq!(lk_breadth(&net, &timed(1.0), 2), 2);
         assert_eq!(lk_breadth(&net, &timed(0.01), 2), 1);
         for (asked, got) in [(0, 1), (1, 1), (3, 3), (9, local::lk3::MAX_BREADTH1)] {
             let opts = SolveOptions { lk_breadth: Some(asked), ..timed(0.01) };

@@ -52,7 +52,8 @@ pub struct Args {
     #[arg(long)]
     pub bound: bool,
     /// On plain symmetric tours, the first-level moves each Lin–Kernighan chain tries before
-    /// giving up, 1 to 4 (default: 2 where the budget allows about 40 kicks per node, else 1).
+    /// giving up, 1 to 4 (default by the budget's kicks per node: 3 from 200, 2 from 40, else
+    /// 1).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(1..=4))]
     pub lk_breadth: Option<u8>,
     #[command(flatten)]
