@@ -98,10 +98,6 @@ pub(crate) struct Budget {
     /// Acceptance temperature: a kick that makes the tour dearer by Δ is kept with probability
     /// exp(-Δ / temperature) (0: only kicks that do not make it dearer).
     pub temperature: Cost,
-    /// First-level moves a 3-opt chain backtracks over (see [`SolveOptions::lk_breadth`]).
-    ///
-    /// [`SolveOptions::lk_breadth`]: crate::SolveOptions::lk_breadth
-    pub breadth1: usize,
 }
 
 pub(crate) struct Ils<'a, 'p, C> {
@@ -121,6 +117,11 @@ pub(crate) struct Ils<'a, 'p, C> {
     /// Kicks without a new best after which the chain restarts from a heavily perturbed copy
     /// of its best tour.
     restart_after: u64,
+    /// First-level moves the kicks' 3-opt chains backtrack over (see
+    /// [`SolveOptions::lk_breadth`]); the descents and polishes keep 1.
+    ///
+    /// [`SolveOptions::lk_breadth`]: crate::SolveOptions::lk_breadth
+    breadth1: usize,
 }
 
 impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
@@ -131,7 +132,12 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         let bridge4 = super::local::uses_or3(net);
         let sop3_bridge = super::sop3::applies(net);
         let restart_after = 16 * net.n as u64 + 200;
-        Ils { net, nb, eps, dp_each_kick, rebuild, bridge4, sop3_bridge, restart_after }
+        Ils { net, nb, eps, dp_each_kick, rebuild, bridge4, sop3_bridge, restart_after, breadth1: 1 }
+    }
+
+    /// The same search with the kicks' chains backtracking over `breadth1` first-level moves.
+    pub fn with_breadth(self, breadth1: usize) -> Self {
+        Ils { breadth1, ..self }
     }
 
     /// Brings a tour to a local optimum of the moves and the mode DP.
@@ -217,7 +223,7 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
         let restart_after = if *restless { RESTLESS_AFTER * cur.len() as u64 + 200 } else { self.restart_after };
         let mut ls = LocalSearch::new(self.net, self.nb, self.eps);
         ls.deadline = budget.hard;
-        ls.breadth1 = budget.breadth1;
+        ls.breadth1 = self.breadth1;
         let n = cur.len();
         let long_bridges = *restless && self.bridge4 && n <= LONG_BRIDGE_UP_TO;
         let mut kicks = 0u64;

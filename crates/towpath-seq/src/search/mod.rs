@@ -328,7 +328,7 @@ fn search<C: CostModel>(
     }
     let eps = 1e-9 * net.typical_arc;
     let nb = candidate_lists(&net, &starts, opts, threads);
-    let ils = Ils::new(&net, &nb, eps);
+    let ils = Ils::new(&net, &nb, eps).with_breadth(lk_breadth(&net, opts, threads));
     // Descend from the best few constructed starts and from the initial route; keep the best
     // local optimum.
     starts.sort_by(|a, b| a.cost.total_cmp(&b.cost));
@@ -603,7 +603,6 @@ fn search_epochs<C: CostModel>(
         d - reserve
     });
     let merge_chains = threads > 1 && local::uses_or3(net);
-    let breadth1 = lk_breadth(net, opts, threads);
     // On plain tours, a population of chains from starts of their own for the first epochs
     // (see `population`), where the budget allows it.
     let per_thread = population::chains_per_thread(net, opts, threads);
@@ -629,7 +628,7 @@ fn search_epochs<C: CostModel>(
         let kicks_each = per_epoch.min(left.div_ceil(threads as u64));
         let frac = budget_used(opts, t0, iterations).unwrap_or(1.0);
         let temperature = acceptance_temperature(net, best.cost, frac);
-        let budget = Budget { kicks: kicks_each, deadline: epoch_deadline, hard: search_end, temperature, breadth1 };
+        let budget = Budget { kicks: kicks_each, deadline: epoch_deadline, hard: search_end, temperature };
         let cancel = clock.cancel_flag().map(|c| &**c);
         let group = chains.len() / threads;
         let done: u64 = if threads == 1 {
