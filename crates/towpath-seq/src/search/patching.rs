@@ -46,7 +46,7 @@ pub(crate) fn arc_matrix<C: CostModel>(net: &Net<C>, deadline: Option<Instant>) 
             return None;
         }
         for b in 0..n as u32 {
-            if a != b && (b == net.anchor || !net.predecessors(a).contains(&b)) {
+            if a != b && (b == net.anchor || !net.direct_predecessors(a).contains(&b)) {
                 c[a as usize * n + b as usize] = net.arc(a, 0, b, 0).min(net.forbidden);
             }
         }
