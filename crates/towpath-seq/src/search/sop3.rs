@@ -97,6 +97,10 @@ impl Sop3 {
                 self.label[s as usize] = st;
             }
             let c = tour.seq[i + 1];
+            if self.label[c as usize] == st {
+                // the right segment would begin with a successor of the left one
+                continue;
+            }
             // gain of removing h->a and i->c and adding h->c
             let g1 = base_h + tour.arc(net, iv, c) - tour.arc(net, hv, c);
             for j in i + 1..=last {
@@ -130,6 +134,10 @@ impl Sop3 {
                 self.label[s as usize] = st;
             }
             let iv = tour.seq[i];
+            if self.label[iv as usize] == st {
+                // the left segment would end with a predecessor of the right one
+                continue;
+            }
             // gain of removing i->c and d->q and adding i->q
             let g1 = base_j + tour.arc(net, iv, c) - tour.arc(net, iv, q);
             for h in (first..i).rev() {
