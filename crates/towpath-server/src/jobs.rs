@@ -2,8 +2,8 @@
 //! live progress for server-sent events, and results kept in the workspace.
 //!
 //! A job's work runs on a blocking thread that holds one of `max_jobs` permits until the work
-//! really ends, so a cancelled or timed-out job whose library call cannot be interrupted still
-//! counts against the bound until it returns. Cancel and the wall limit end the job's state at
+//! really ends and its result is stored, so a cancelled or timed-out job whose library call
+//! cannot be interrupted still counts against the bound until it returns. Cancel and the wall limit end the job's state at
 //! once; whatever the work returns afterwards is dropped.
 
 use std::collections::BTreeMap;
@@ -346,11 +346,18 @@ async fn run(state: Arc<AppState>, job: Arc<Job>, work: Work) {
         v.phase = "starting".into();
     });
     let ctx = JobCtx { job: job.clone() };
+    // The work hands its permit back with its result, so that the slot stays taken until the
+    // result is stored and the job is done (else the next job shows as running beside it). A
+    // job past the wall limit is let go, and its permit is dropped only when its work returns.
     let handle = tokio::task::spawn_blocking(move || {
-        let _permit = permit;
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| work(&ctx)))
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| work(&ctx)));
+        (result, permit)
     });
-    let outcome = tokio::time::timeout(state.jobs.wall, handle).await;
+    let (outcome, _permit) = match tokio::time::timeout(state.jobs.wall, handle).await {
+        Ok(Ok((result, permit))) => (Ok(Ok(result)), Some(permit)),
+        Ok(Err(e)) => (Ok(Err(e)), None),
+        Err(e) => (Err(e), None),
+    };
     let elapsed = job.elapsed_now();
     match outcome {
         Err(_) => {
