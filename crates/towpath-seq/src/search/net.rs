@@ -419,9 +419,9 @@ impl<'p, C: CostModel> Net<'p, C> {
         }
     }
 
-    /// The nodes `v` must come right before in the transitive reduction of the precedence:
-    /// enough to keep the whole precedence when a feasible tour is rearranged, as every pair
-    /// tied only through others has those others between it.
+    /// The nodes that must come after `v` (not necessarily at once), by the transitive
+    /// reduction of the precedence: enough to keep the whole precedence when a feasible tour
+    /// is rearranged, as every pair tied only through others has those others between it.
     #[inline]
     pub fn successors(&self, v: u32) -> &[u32] {
         &self.succ[self.succ_off[v as usize] as usize..self.succ_off[v as usize + 1] as usize]
