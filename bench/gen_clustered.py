@@ -31,10 +31,6 @@ ROOT = Path(__file__).resolve().parent.parent
 #: diagonal is 56,569 ≤ 65,535), large enough that rounding to integers hardly matters.
 SIDE = 40_000.0
 
-#: Largest instance in list.txt: bench/seq.py gives the peers a full matrix, which `towpath
-#: convert --matrix` writes up to 5,000 nodes. The 10,000-node files are for direct runs.
-SEQ_PY_LIMIT = 5000
-
 #: (family, n, clusters, seed) of the default set; clusters is ignored by `portc`.
 DEFAULT = [
     ("gauss", 2000, 40, 1),
@@ -92,8 +88,7 @@ def main() -> None:
                 pts, comment = portc(n, seed), f"{n} points, portcgen-like clusters (bench/gen_clustered.py)"
             write_tsp(args.out / f"{name}.tsp", name, comment, pts)
             rows.append(f"{name},TSP,{n},,none,{name}.tsp,bench/gen_clustered.py,")
-            if n <= SEQ_PY_LIMIT:
-                names.append(f"{name}.tsp")
+            names.append(f"{name}.tsp")
     (args.out / "index.csv").write_text(
         "name,type,dimension,value,value_status,path,source_repo,note\n" + "\n".join(rows) + "\n")
     (args.out / "list.txt").write_text("# clustered instances (bench/gen_clustered.py)\n" + "\n".join(names) + "\n")

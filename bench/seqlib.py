@@ -69,13 +69,63 @@ def read_instance_list(path: Path) -> list[str]:
 # --------------------------------------------------------------------------- model
 
 
+class PointCosts:
+    """The cost matrix of a coordinate instance, each entry computed when read: what `Model`
+    holds for instances too large for `towpath convert --matrix` (over 5,000 points; a full
+    matrix of Python floats at 10,000 points would take gigabytes). `costs[i][j]` as for a list
+    of rows; only TSPLIB's EUC_2D (`euclidean_nint`: the Euclidean distance rounded to the
+    nearest integer) and CEIL_2D (`euclidean_ceil`)."""
+
+    METRICS = ("euclidean_nint", "euclidean_ceil")
+
+    def __init__(self, points: list[list[float]], metric: str):
+        if metric not in self.METRICS:
+            raise ValueError(f"metric {metric!r} is not computed on demand (only {', '.join(self.METRICS)})")
+        if any(len(p) != 2 for p in points):
+            raise ValueError("only 2-D points are computed on demand")
+        self.points = [(float(p[0]), float(p[1])) for p in points]
+        self.metric = metric
+
+    def cost(self, i: int, j: int) -> float:
+        (xi, yi), (xj, yj) = self.points[i], self.points[j]
+        d = math.hypot(xi - xj, yi - yj)
+        return float(math.floor(d + 0.5) if self.metric == "euclidean_nint" else math.ceil(d))
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    def __getitem__(self, i: int) -> "_PointRow":
+        if not 0 <= i < len(self.points):
+            raise IndexError(i)
+        return _PointRow(self, i)
+
+    def __iter__(self):
+        return (self[i] for i in range(len(self.points)))
+
+
+class _PointRow:
+    """Row `i` of a [`PointCosts`] matrix."""
+
+    def __init__(self, costs: PointCosts, i: int):
+        self.costs, self.i = costs, i
+
+    def __getitem__(self, j: int) -> float:
+        return self.costs.cost(self.i, j)
+
+    def __len__(self) -> int:
+        return len(self.costs)
+
+    def __iter__(self):
+        return (self.costs.cost(self.i, j) for j in range(len(self.costs)))
+
+
 @dataclass
 class Model:
     """The part of a towpath JSON problem the benchmark needs: states with an explicit matrix
     (None = forbidden move), tasks with modes (entry, exit, cost), precedence between tasks,
     pins and ends. Tasks and states are 0-based indices."""
 
-    matrix: list[list[float | None]]
+    matrix: list[list[float | None]] | PointCosts
     modes: list[list[tuple[int, int, float]]]
     precedence: list[tuple[int, int]] = field(default_factory=list)
     start: int | None = None
@@ -96,9 +146,14 @@ class Model:
     @staticmethod
     def from_json(doc: dict) -> "Model":
         """Reads a towpath JSON problem that has `states.matrix` (write it with
-        `towpath convert --matrix`)."""
+        `towpath convert --matrix`), or 2-D `states.points` with a metric [`PointCosts`]
+        computes."""
         states = doc["states"]
-        if "matrix" not in states:
+        if "matrix" in states:
+            matrix = states["matrix"]
+        elif "points" in states and states.get("metric") in PointCosts.METRICS:
+            matrix = PointCosts(states["points"], states["metric"])
+        else:
             raise ValueError("the problem has no explicit matrix: convert it with --matrix")
         ids = [t["id"] for t in doc["tasks"]]
         index = {tid: k for k, tid in enumerate(ids)}
@@ -111,7 +166,7 @@ class Model:
         if isinstance(end, dict):
             end_state, end = end["at"], "at"
         return Model(
-            matrix=states["matrix"],
+            matrix=matrix,
             modes=modes,
             precedence=[(index[a], index[b]) for a, b in doc.get("precedence", [])],
             start=doc.get("start"),

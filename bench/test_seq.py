@@ -5,6 +5,7 @@ transformation, medians, gaps and the table. Run with `python3 -m unittest bench
 from __future__ import annotations
 
 import itertools
+import math
 import random
 import sys
 import tempfile
@@ -92,6 +93,24 @@ class CheckRouteTest(unittest.TestCase):
         self.assertEqual(seqlib.price_states(model, [0, 1, 2]), 5)
         with self.assertRaises(ValueError):
             Model.from_json({"states": {"points": [[0, 0]]}, "tasks": []})
+
+    def test_point_costs_price_tours_as_the_explicit_matrix_does(self):
+        rng = random.Random(7)
+        pts = [[rng.uniform(0, 1000), rng.uniform(0, 1000)] for _ in range(30)]
+        tasks = [{"id": str(i + 1), "modes": [{"entry": i}]} for i in range(30)]
+        for metric, rnd in (("euclidean_nint", lambda d: int(d + 0.5)), ("euclidean_ceil", math.ceil)):
+            lazy = Model.from_json({"states": {"points": pts, "metric": metric}, "tasks": tasks})
+            full = [[float(rnd(math.dist(p, q))) for q in pts] for p in pts]
+            explicit = Model.from_json({"states": {"matrix": full}, "tasks": tasks})
+            self.assertEqual([list(r) for r in lazy.matrix], full)
+            for _ in range(5):
+                tour = list(range(30))
+                rng.shuffle(tour)
+                self.assertEqual(seqlib.price_states(lazy, tour), seqlib.price_states(explicit, tour))
+        with self.assertRaises(ValueError):
+            Model.from_json({"states": {"points": pts, "metric": "geo"}, "tasks": tasks})
+        with self.assertRaises(ValueError):
+            Model.from_json({"states": {"points": [[0, 0, 0]], "metric": "euclidean_nint"}, "tasks": tasks[:1]})
 
     def test_topological_order_is_feasible(self):
         rng = random.Random(3)
