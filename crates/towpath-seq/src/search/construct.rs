@@ -3,6 +3,7 @@
 
 use std::time::Instant;
 
+use super::neighbors::Neighbors;
 use super::net::Net;
 use crate::cost::{Cost, CostModel};
 use crate::model::{TaskId, NO_GROUP};
@@ -64,6 +65,55 @@ pub(crate) fn nearest_neighbor<C: CostModel>(
     let mode = b.mode;
     rotate_to_anchor(net, &mut seq);
     Some((seq, mode))
+}
+
+/// Nearest neighbour through candidate lists, for plain one-mode tours: from `first`, to the
+/// nearest unvisited node on the current node's list (`nb`, sorted by cost), or when the whole
+/// list is visited, to the nearest unvisited node of all. The lists make it about O(n·k) where
+/// [`nearest_neighbor`] is O(n²) (at 10,000 points about 1.2 s against a few milliseconds).
+pub(crate) fn nearest_neighbor_by_lists<C: CostModel>(net: &Net<C>, nb: &Neighbors, first: u32) -> Vec<u32> {
+    let n = net.n;
+    // the unvisited nodes, and each node's place among them (u32::MAX once visited)
+    let mut left: Vec<u32> = (0..n as u32).collect();
+    let mut at: Vec<u32> = (0..n as u32).collect();
+    let take = |left: &mut Vec<u32>, at: &mut Vec<u32>, v: u32| {
+        let i = at[v as usize] as usize;
+        let last = *left.last().expect("v is unvisited");
+        left.swap_remove(i);
+        at[last as usize] = i as u32;
+        at[v as usize] = u32::MAX;
+    };
+    let mut seq = Vec::with_capacity(n);
+    if n == 0 {
+        return seq;
+    }
+    let mut cur = first.min(n as u32 - 1);
+    take(&mut left, &mut at, cur);
+    seq.push(cur);
+    while !left.is_empty() {
+        let mut best = (Cost::INFINITY, u32::MAX);
+        for &u in nb.out(cur) {
+            if at[u as usize] != u32::MAX {
+                let c = net.arc(cur, 0, u, 0);
+                if c < best.0 {
+                    best = (c, u);
+                }
+            }
+        }
+        if best.1 == u32::MAX {
+            for &u in &left {
+                let c = net.arc(cur, 0, u, 0);
+                if best.1 == u32::MAX || c < best.0 {
+                    best = (c, u);
+                }
+            }
+        }
+        cur = best.1;
+        take(&mut left, &mut at, cur);
+        seq.push(cur);
+    }
+    rotate_to_anchor(net, &mut seq);
+    seq
 }
 
 /// The tour that takes the tasks in the order of `pos` (a position per node), each as soon as
@@ -275,4 +325,34 @@ fn hilbert_index(bits: u32, mut x: u32, mut y: u32) -> u64 {
         s >>= 1;
     }
     d
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+    use rand_pcg::Pcg64Mcg;
+
+    use super::*;
+    use crate::search::testing::random_tour_problem;
+
+    /// With lists of every other node, the walk through the lists is the nearest-neighbour
+    /// tour itself; with short lists it still visits every node once, anchor first.
+    #[test]
+    fn nearest_neighbor_through_lists_is_nearest_neighbor() {
+        for seed in 0..20u64 {
+            let mut rng = Pcg64Mcg::seed_from_u64(seed);
+            let n = 5 + seed as usize * 7;
+            let p = random_tour_problem(&mut rng, n, 1000.0);
+            let net = Net::new(&p);
+            let first = (seed as u32 * 3) % n as u32;
+            let full = Neighbors::build(&net, n - 1);
+            let (expected, _) = nearest_neighbor(&net, Some(first), None).expect("no deadline");
+            assert_eq!(nearest_neighbor_by_lists(&net, &full, first), expected, "seed {seed}");
+            let short = Neighbors::build(&net, 3);
+            let mut seq = nearest_neighbor_by_lists(&net, &short, first);
+            assert_eq!(seq[0], net.anchor, "seed {seed}");
+            seq.sort_unstable();
+            assert_eq!(seq, (0..n as u32).collect::<Vec<_>>(), "seed {seed}");
+        }
+    }
 }

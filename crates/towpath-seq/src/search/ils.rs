@@ -164,42 +164,8 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
     pub fn fresh_start(&self, rng: &mut Pcg64Mcg, deadline: Option<Instant>) -> Tour {
         let net = self.net;
         let n = net.n;
-        let mut left: Vec<u32> = (0..n as u32).collect();
-        let mut at: Vec<u32> = (0..n as u32).collect();
-        let mut seq = Vec::with_capacity(n);
-        let take = |left: &mut Vec<u32>, at: &mut Vec<u32>, v: u32| {
-            let i = at[v as usize] as usize;
-            let last = *left.last().expect("v is left");
-            left.swap_remove(i);
-            at[last as usize] = i as u32;
-            at[v as usize] = u32::MAX;
-        };
-        let mut cur = rng.gen_range(0..n as u32);
-        take(&mut left, &mut at, cur);
-        seq.push(cur);
-        while !left.is_empty() {
-            let mut best = (Cost::INFINITY, u32::MAX);
-            for &u in self.nb.out(cur) {
-                if at[u as usize] != u32::MAX {
-                    let c = net.arc(cur, 0, u, 0);
-                    if c < best.0 {
-                        best = (c, u);
-                    }
-                }
-            }
-            if best.1 == u32::MAX {
-                for &u in &left {
-                    let c = net.arc(cur, 0, u, 0);
-                    if best.1 == u32::MAX || c < best.0 {
-                        best = (c, u);
-                    }
-                }
-            }
-            cur = best.1;
-            take(&mut left, &mut at, cur);
-            seq.push(cur);
-        }
-        super::construct::rotate_to_anchor(net, &mut seq);
+        let first = rng.gen_range(0..n as u32);
+        let seq = super::construct::nearest_neighbor_by_lists(net, self.nb, first);
         let mut tour = Tour::new(net, seq, vec![0; n]);
         self.descend(&mut tour, deadline);
         tour

@@ -93,6 +93,7 @@ pub(crate) fn partition_crossover<C: CostModel>(
 
     // The child's arcs, as a's to start with.
     let mut cur: Vec<[u32; 2]> = (0..n as u32).map(|v| adj(a, v)).collect();
+    let shortcuts = Shortcuts::new(&cur, &in_comp);
     let mut done = vec![false; n];
     let mut switched: Vec<u32> = Vec::new();
     let mut total = 0.0;
@@ -108,7 +109,7 @@ pub(crate) fn partition_crossover<C: CostModel>(
         }
         set(&mut cur, r, b);
         tries += 1;
-        if one_cycle(&cur) {
+        if shortcuts.one_cycle(&cur) {
             total += gain[r];
             done[r] = true;
             switched.extend_from_slice(&members[r]);
@@ -123,7 +124,7 @@ pub(crate) fn partition_crossover<C: CostModel>(
             }
             set(&mut cur, o, b);
             tries += 1;
-            if one_cycle(&cur) {
+            if shortcuts.one_cycle(&cur) {
                 total += gain[r] + gain[o];
                 done[r] = true;
                 done[o] = true;
@@ -159,6 +160,90 @@ fn step(adj: &[[u32; 2]], prev: u32, x: u32) -> u32 {
         p
     } else {
         q
+    }
+}
+
+/// The runs of arcs both tours share, for walking a child in steps between the nodes of the
+/// components instead of node by node: a node outside every component keeps its two arcs in
+/// any child, so from a component's node `v` on to such a neighbour `u` the walk always goes on
+/// along the same run until it meets the next node of a component. At 10,000 points the
+/// components of two local optima hold a fraction of the nodes, and each try of a component
+/// walks only those.
+struct Shortcuts {
+    /// The first node of a component on the run, the node just before it, and the run's length
+    /// in arcs, keyed by (component node, its neighbour outside the components) at `slot[v]`.
+    runs: Vec<[(u32, u32, u32, u32); 2]>,
+    /// A node of a component to start the walk from (`u32::MAX` when there is none).
+    start: u32,
+    /// Nodes in all.
+    n: usize,
+}
+
+impl Shortcuts {
+    /// The runs from every component node of `adj` (the arcs of one parent) along its
+    /// neighbours outside the components (`in_comp[v]`: `v` is a node of some component).
+    fn new(adj: &[[u32; 2]], in_comp: &[bool]) -> Self {
+        let n = adj.len();
+        let none = (u32::MAX, u32::MAX, u32::MAX, 0);
+        let mut runs = vec![[none; 2]; n];
+        let mut start = u32::MAX;
+        for v in 0..n as u32 {
+            if !in_comp[v as usize] {
+                continue;
+            }
+            if start == u32::MAX {
+                start = v;
+            }
+            for (k, &u) in adj[v as usize].iter().enumerate() {
+                if in_comp[u as usize] {
+                    continue;
+                }
+                let (mut prev, mut x, mut len) = (v, u, 1u32);
+                while !in_comp[x as usize] {
+                    (prev, x) = (x, step(adj, prev, x));
+                    len += 1;
+                }
+                runs[v as usize][k] = (u, x, prev, len);
+            }
+        }
+        Shortcuts { runs, start, n }
+    }
+
+    /// Whether the arcs (two per node) form one cycle through every node; the nodes outside the
+    /// components must have the arcs they had when `self` was built.
+    fn one_cycle(&self, adj: &[[u32; 2]]) -> bool {
+        if self.start == u32::MAX {
+            return one_cycle(adj);
+        }
+        let (mut prev, mut x) = (u32::MAX, self.start);
+        let mut k = 0usize;
+        loop {
+            let y = step(adj, prev, x);
+            let [r0, r1] = self.runs[x as usize];
+            let run = if r0.0 == y {
+                Some(r0)
+            } else if r1.0 == y {
+                Some(r1)
+            } else {
+                None
+            };
+            match run {
+                Some((_, end, before, len)) => {
+                    (prev, x) = (before, end);
+                    k += len as usize;
+                }
+                None => {
+                    (prev, x) = (x, y);
+                    k += 1;
+                }
+            }
+            if x == self.start {
+                return k == self.n;
+            }
+            if k >= self.n {
+                return false;
+            }
+        }
     }
 }
 
@@ -267,6 +352,63 @@ mod tests {
                 let child = Tour::new(&net, seq, vec![0; n]);
                 assert!(child.cost < a.cost.min(b.cost) + 1e-9, "trial {trial}");
             }
+        }
+    }
+
+    /// The walk along shared runs answers as the walk node by node does, on children that
+    /// take each component of two tours' unshared arcs from either tour at random.
+    #[test]
+    fn shortcut_walks_agree_with_node_by_node_walks() {
+        let mut rng = Pcg64Mcg::seed_from_u64(17);
+        for trial in 0..400 {
+            let n = rng.gen_range(8..80usize);
+            let mut seq: Vec<u32> = (0..n as u32).collect();
+            for i in (1..n).rev() {
+                seq.swap(i, rng.gen_range(0..=i));
+            }
+            let mut other = seq.clone();
+            for _ in 0..rng.gen_range(1..5) {
+                let i = rng.gen_range(0..n - 1);
+                let j = rng.gen_range(i + 1..n);
+                other[i..=j].reverse();
+            }
+            let adj_of = |s: &[u32]| {
+                let mut adj = vec![[0u32; 2]; n];
+                for i in 0..n {
+                    adj[s[i] as usize] = [s[(i + n - 1) % n], s[(i + 1) % n]];
+                }
+                adj
+            };
+            let (a, b) = (adj_of(&seq), adj_of(&other));
+            let has = |adj: &[[u32; 2]], u: u32, v: u32| adj[u as usize].contains(&v);
+            let mut parent: Vec<usize> = (0..n).collect();
+            fn root(parent: &[usize], mut x: usize) -> usize {
+                while parent[x] != x {
+                    x = parent[x];
+                }
+                x
+            }
+            let mut in_comp = vec![false; n];
+            for (t, o) in [(&a, &b), (&b, &a)] {
+                for u in 0..n as u32 {
+                    for &v in &t[u as usize] {
+                        if !has(o, u, v) {
+                            in_comp[u as usize] = true;
+                            in_comp[v as usize] = true;
+                            let (ru, rv) = (root(&parent, u as usize), root(&parent, v as usize));
+                            parent[ru] = rv;
+                        }
+                    }
+                }
+            }
+            let shortcuts = Shortcuts::new(&a, &in_comp);
+            for _ in 0..8 {
+                let take_b: Vec<bool> = (0..n).map(|_| rng.gen_bool(0.5)).collect();
+                let cur: Vec<[u32; 2]> =
+                    (0..n).map(|v| if in_comp[v] && take_b[root(&parent, v)] { b[v] } else { a[v] }).collect();
+                assert_eq!(shortcuts.one_cycle(&cur), one_cycle(&cur), "trial {trial}");
+            }
+            assert!(shortcuts.one_cycle(&a) && shortcuts.one_cycle(&b), "trial {trial}");
         }
     }
 }
