@@ -525,8 +525,9 @@ const LIST_START_FROM: usize = 4_000;
 
 /// True when the candidate lists are built before the starts, and the start is the nearest
 /// neighbour through them: plain symmetric one-mode tours (no precedence, groups or fixed
-/// edges, no fixed start) of [`LIST_START_FROM`] to [`SPACE_FILLING_FROM`] nodes whose lists take no α pass
-/// (the only kind of list that needs a start: its ascent's step length uses a tour's cost).
+/// edges, no fixed start) of [`LIST_START_FROM`] to [`SPACE_FILLING_FROM`] nodes whose lists
+/// take no α pass (the only kind of list that needs a start: its ascent's step length uses a
+/// tour's cost).
 fn lists_before_starts<C: CostModel>(net: &Net<C>, opts: &SolveOptions, threads: usize) -> bool {
     (LIST_START_FROM..=SPACE_FILLING_FROM).contains(&net.n)
         && local::uses_or3(net)
