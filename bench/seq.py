@@ -8,7 +8,8 @@ local search) on the same instances, at the same time limit, in the same run.
     python3 bench/seq.py --scale-only            # the 100,000-task scale check alone
 
 Every instance is converted once by `towpath convert --matrix` into towpath's JSON format, so the
-peers read exactly the problem towpath solves; every peer answer is re-priced and checked for
+peers read exactly the problem towpath solves (coordinate files of over 5,000 points, too large
+for a matrix, are read as points and priced from them: seqlib.PointCosts); every peer answer is re-priced and checked for
 feasibility here (bench/seqlib.py) before it is reported. The peers are installed into
 bench/.venv (pinned versions) on first use. Raw results go to bench/out/seq-results.jsonl
 (`--resume` skips what is already there), the table into BENCHMARKS.md between the
