@@ -98,6 +98,9 @@ pub(crate) struct Budget {
     /// Acceptance temperature: a kick that makes the tour dearer by Δ is kept with probability
     /// exp(-Δ / temperature) (0: only kicks that do not make it dearer).
     pub temperature: Cost,
+    /// Record-to-record slack: a kick whose tour costs at most the chain's best plus this is
+    /// kept even when dearer than the tour it was applied to (0: no slack).
+    pub slack: Cost,
 }
 
 pub(crate) struct Ils<'a, 'p, C> {
@@ -277,6 +280,9 @@ impl<'a, 'p, C: CostModel> Ils<'a, 'p, C> {
                     best.mode.copy_from_slice(&cur.mode);
                     best.cost = cur.cost;
                 }
+            } else if budget.slack > 0.0 && cur.cost <= best.cost + budget.slack {
+                // record-to-record travel: the walk may drift a little above its best
+                cur.commit();
             } else if budget.temperature > 0.0 && self.accept_worse(cur.cost - before, budget.temperature, rng) {
                 cur.commit();
             } else {
@@ -659,5 +665,36 @@ mod tests {
         let tour = Tour::new(&net, (0..n).collect(), vec![0; n as usize]);
         let mut rng = Pcg64Mcg::seed_from_u64(1);
         assert!(ils.long_arc_cuts(&tour, &mut rng).is_none());
+    }
+
+    /// Record-to-record acceptance: with a slack the walk goes above its best (some kicks are
+    /// kept dearer) but never by more than the slack, and the best stays the cheapest tour the
+    /// walk has had; with no slack the walk never goes above its best. Costs are checked
+    /// against a full re-pricing after every kick (1,500 kicks: fewer than a restart needs).
+    #[test]
+    fn record_to_record_walks_stay_within_the_slack() {
+        let mut rng = Pcg64Mcg::seed_from_u64(5);
+        let p = clustered(&mut rng, 12, 20);
+        let net = Net::new(&p);
+        let nb = Neighbors::build(&net, 8);
+        let ils = Ils::new(&net, &nb, 1e-9);
+        let n = 240u32;
+        let start = Tour::new(&net, (0..n).collect(), vec![0; n as usize]);
+        let mean_arc = start.full_cost(&net) / n as Cost;
+        for slack in [0.0, 0.5 * mean_arc] {
+            let mut chain = Chain::new(&start, 7);
+            let budget = Budget { kicks: 1, deadline: None, hard: None, temperature: 0.0, slack };
+            let (mut above, mut cheapest) = (0, Cost::INFINITY);
+            for _ in 0..1_500 {
+                ils.run(&mut chain, budget, None);
+                let (cur, best) = (chain.cur.full_cost(&net), chain.best.full_cost(&net));
+                assert!((cur - chain.cur.cost).abs() < 1e-6 * cur && (best - chain.best.cost).abs() < 1e-6 * best);
+                assert!(cur <= best + slack + 1e-6, "walk {cur} above best {best} + slack {slack}");
+                cheapest = cheapest.min(cur);
+                assert!(best <= cheapest + 1e-6, "best {best} dearer than a tour of the walk {cheapest}");
+                above += usize::from(cur > best + 1e-6);
+            }
+            assert_eq!(above > 0, slack > 0.0, "slack {slack}: the walk was above its best {above} times");
+        }
     }
 }

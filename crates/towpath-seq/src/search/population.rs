@@ -185,7 +185,7 @@ mod tests {
         let mut chains: Vec<Chain> = (0..6)
             .map(|s| {
                 let mut c = Chain::new(&ils.fresh_start(&mut Pcg64Mcg::seed_from_u64(s), None), s);
-                let budget = Budget { kicks: 200, deadline: None, hard: None, temperature: 0.0 };
+                let budget = Budget { kicks: 200, deadline: None, hard: None, temperature: 0.0, slack: 0.0 };
                 ils.run(&mut c, budget, None);
                 c
             })
