@@ -678,7 +678,7 @@ mod tests {
         let net = Net::new(&p);
         let nb = Neighbors::build(&net, 8);
         let ils = Ils::new(&net, &nb, 1e-9);
-        let n = 240u32;
+        let n = net.n as u32;
         let start = Tour::new(&net, (0..n).collect(), vec![0; n as usize]);
         let mean_arc = start.full_cost(&net) / n as Cost;
         for slack in [0.0, 0.5 * mean_arc] {

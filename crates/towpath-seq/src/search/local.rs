@@ -130,6 +130,13 @@ pub(crate) fn uses_or3<C: CostModel>(net: &Net<'_, C>) -> bool {
     net.plain_symmetric && !net.multi_mode && !net.has_prec && !net.has_groups && net.n <= OR3_UP_TO
 }
 
+/// Plain tours: the 3-opt chains' problems ([`uses_or3`]) with no two-way tasks (no fixed
+/// partner edges). The population, the list start and the record-to-record acceptance are for
+/// these.
+pub(crate) fn plain_tour<C: CostModel>(net: &Net<'_, C>) -> bool {
+    uses_or3(net) && net.partner.is_empty()
+}
+
 /// An improving Or-opt move found by the scans.
 #[derive(Clone, Copy)]
 struct Insertion {

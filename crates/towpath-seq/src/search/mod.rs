@@ -530,8 +530,7 @@ const LIST_START_FROM: usize = 4_000;
 /// tour's cost).
 fn lists_before_starts<C: CostModel>(net: &Net<C>, opts: &SolveOptions, threads: usize) -> bool {
     (LIST_START_FROM..=SPACE_FILLING_FROM).contains(&net.n)
-        && local::uses_or3(net)
-        && net.partner.is_empty()
+        && local::plain_tour(net)
         && net.depot == u32::MAX
         && alpha::plan(net.n, threads, opts.time_limit.map(|d| d.as_secs_f64())).is_none()
 }
@@ -836,7 +835,7 @@ const RECORD_SLACK: f64 = 0.03;
 /// problems with no two-way tasks); precedence has its annealing instead
 /// ([`acceptance_temperature`]), other problems accept no dearer tour.
 fn acceptance_slack<C: CostModel>(net: &Net<C>, best: Cost) -> Cost {
-    if !local::uses_or3(net) || !net.partner.is_empty() || best.abs() >= net.forbidden {
+    if !local::plain_tour(net) || best.abs() >= net.forbidden {
         return 0.0;
     }
     RECORD_SLACK * best.abs() / net.n as f64

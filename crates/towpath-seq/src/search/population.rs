@@ -42,7 +42,7 @@ const NODE_KICKS: f64 = 0.25;
 /// plain (the local search has 3-opt chains and no fixed edges) and the budget gives each chain
 /// [`NODE_SECONDS`] (or [`NODE_KICKS`]) per node.
 pub(crate) fn chains_per_thread<C: CostModel>(net: &Net<C>, opts: &SolveOptions, threads: usize) -> usize {
-    if !local::uses_or3(net) || !net.partner.is_empty() || net.n < 8 {
+    if !local::plain_tour(net) || net.n < 8 {
         return 1;
     }
     let share = EPOCHS as f64 / super::EPOCHS_PLANNED as f64;
