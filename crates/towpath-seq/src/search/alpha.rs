@@ -15,7 +15,7 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-use super::neighbors::Neighbors;
+use super::neighbors::{self, Neighbors};
 use super::net::Net;
 use crate::cost::{Cost, CostModel};
 
@@ -130,7 +130,7 @@ pub(crate) fn candidates<C: CostModel>(
         return None;
     }
     let arc = |a: u32, b: u32| net.arc(a, 0, b, 0);
-    let mut g = sparse_graph(n, nb, &arc);
+    let mut g = sparse_graph(net, nb, &arc);
     let pi = ascent(&mut g, vec![0.0; n], steps, ub, &arc);
     let tree = prim(&mut g, &pi, &arc);
     let mut lists = lowest_alpha(n, &tree, &pi, ALPHA_K, threads, &arc);
@@ -174,7 +174,7 @@ pub(crate) fn held_karp_bound<C: CostModel>(net: &Net<C>, nb: &Neighbors, ub: Co
     }
     let arc = |a: u32, b: u32| net.arc(a, 0, b, 0);
     let own: Cost = (0..n as u32).map(|v| net.mode_cost(v, 0)).sum();
-    let mut g = sparse_graph(n, nb, &arc);
+    let mut g = sparse_graph(net, nb, &arc);
     let mut pi = vec![0.0; n];
     let mut best = Cost::NEG_INFINITY;
     for round in 0..BOUND_ROUNDS {
@@ -254,16 +254,60 @@ fn complete_one_tree(pi: &[Cost], arc: &impl Fn(u32, u32) -> Cost) -> (Cost, Vec
     (total + extra.0 - 2.0 * pi.iter().sum::<Cost>(), edges)
 }
 
-/// The nearest-neighbour lists as an undirected graph.
-fn sparse_graph(n: usize, nb: &Neighbors, arc: &impl Fn(u32, u32) -> Cost) -> Graph {
-    let mut edges: Vec<(u32, u32)> = Vec::new();
-    for v in 0..n as u32 {
-        for &u in nb.out(v) {
-            edges.push((v, u));
-            edges.push((u, v));
+/// The nearest-neighbour lists as an undirected graph, joined where it falls apart (clusters
+/// further apart than their points' nearest neighbours): on tasks in a plane, by the cheapest
+/// links between the pieces among each node's [`LINK_PER_QUADRANT`] nearest in each quadrant
+/// around it, taken cheapest first while they join two pieces (Kruskal). Where pieces are left,
+/// [`prim`] joins them by a full scan, which costs O(n²) a time (seconds on 10,000 clustered
+/// points).
+fn sparse_graph<C: CostModel>(net: &Net<C>, nb: &Neighbors, arc: &impl Fn(u32, u32) -> Cost) -> Graph {
+    let n = net.n;
+    let mut edges: Vec<(u32, u32)> =
+        (0..n as u32).flat_map(|v| nb.out(v).iter().flat_map(move |&u| [(v, u), (u, v)])).collect();
+    let mut pieces = Pieces::new(n);
+    let apart = edges.iter().filter(|&&(a, b)| pieces.join(a, b)).count() + 1 < n;
+    if apart {
+        if let Some(q) = neighbors::quadrant_lists(net, 1, LINK_PER_QUADRANT) {
+            let mut links: Vec<(Cost, u32, u32)> =
+                (0..n as u32).flat_map(|v| q.out(v).iter().map(move |&u| (arc(v, u), v, u))).collect();
+            links.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+            for (_, a, b) in links {
+                if pieces.join(a, b) {
+                    edges.extend([(a, b), (b, a)]);
+                }
+            }
         }
     }
     csr(n, edges, arc)
+}
+
+/// Neighbours per quadrant among which the links between pieces are sought.
+const LINK_PER_QUADRANT: usize = 2;
+
+/// Disjoint pieces of a graph's nodes (union–find with path halving).
+struct Pieces(Vec<u32>);
+
+impl Pieces {
+    fn new(n: usize) -> Pieces {
+        Pieces((0..n as u32).collect())
+    }
+
+    fn root(&mut self, mut v: u32) -> u32 {
+        while self.0[v as usize] != v {
+            self.0[v as usize] = self.0[self.0[v as usize] as usize];
+            v = self.0[v as usize];
+        }
+        v
+    }
+
+    /// Joins the pieces of `a` and `b`; false when they were one piece already.
+    fn join(&mut self, a: u32, b: u32) -> bool {
+        let (ra, rb) = (self.root(a), self.root(b));
+        if ra != rb {
+            self.0[ra as usize] = rb;
+        }
+        ra != rb
+    }
 }
 
 /// The graph of directed `edges` (each edge given both ways) in compressed rows.
@@ -452,20 +496,57 @@ fn lowest_alpha(
     threads: usize,
     arc: &(impl Fn(u32, u32) -> Cost + Sync),
 ) -> Vec<Vec<u32>> {
+    let walk = TreeWalk::new(tree, pi, arc);
     let threads = threads.clamp(1, 64).min(n);
     if threads == 1 {
-        return alpha_rows(0..n as u32, n, tree, pi, k, arc);
+        return alpha_rows(0..n as u32, &walk, pi, k, arc);
     }
     let chunk = n.div_ceil(threads) as u32;
+    let walk = &walk;
     std::thread::scope(|s| {
         let handles: Vec<_> = (0..threads as u32)
             .map(|t| {
                 let rows = (t * chunk).min(n as u32)..((t + 1) * chunk).min(n as u32);
-                s.spawn(move || alpha_rows(rows, n, tree, pi, k, arc))
+                s.spawn(move || alpha_rows(rows, walk, pi, k, arc))
             })
             .collect();
         handles.into_iter().flat_map(|h| h.join().expect("α thread panicked")).collect()
     })
+}
+
+/// The minimum spanning tree laid out by Prim's order (parents before children) for the α
+/// pass, which walks the whole tree once per node: each place's node, its parent's place, the
+/// penalised cost of the edge to the parent and the node's π, in arrays read front to back.
+struct TreeWalk {
+    node: Vec<u32>,
+    place: Vec<u32>,
+    parent: Vec<u32>,
+    up: Vec<Cost>,
+    pi: Vec<Cost>,
+}
+
+impl TreeWalk {
+    fn new(tree: &Tree, pi: &[Cost], arc: &impl Fn(u32, u32) -> Cost) -> TreeWalk {
+        let node = tree.order.clone();
+        let mut place = vec![0u32; node.len()];
+        for (q, &v) in node.iter().enumerate() {
+            place[v as usize] = q as u32;
+        }
+        let parent: Vec<u32> = node.iter().map(|&v| place[tree.parent[v as usize] as usize]).collect();
+        let up = node
+            .iter()
+            .map(|&v| {
+                let d = tree.parent[v as usize];
+                if d == v {
+                    Cost::NEG_INFINITY
+                } else {
+                    arc(v, d) + pi[v as usize] + pi[d as usize]
+                }
+            })
+            .collect();
+        let pi = node.iter().map(|&v| pi[v as usize]).collect();
+        TreeWalk { node, place, parent, up, pi }
+    }
 }
 
 /// Candidate lists of the nodes in `rows`. β(i,j), the dearest tree edge on the path from i to
@@ -473,40 +554,39 @@ fn lowest_alpha(
 /// i's path to the root.
 fn alpha_rows(
     rows: std::ops::Range<u32>,
-    n: usize,
-    tree: &Tree,
+    walk: &TreeWalk,
     pi: &[Cost],
     k: usize,
     arc: &impl Fn(u32, u32) -> Cost,
 ) -> Vec<Vec<u32>> {
+    let n = walk.node.len();
     let k = k.min(n - 1);
-    let root = tree.order[0];
-    let pc = |a: u32, b: u32| arc(a, b) + pi[a as usize] + pi[b as usize];
     let mut beta = vec![Cost::NEG_INFINITY; n];
     let mut mark = vec![u32::MAX; n];
     let mut lists = Vec::with_capacity(rows.len());
     let mut best: Vec<(Cost, Cost, u32)> = Vec::with_capacity(k + 1);
     for i in rows {
-        beta[i as usize] = Cost::NEG_INFINITY;
-        mark[i as usize] = i;
-        let mut u = i;
-        while u != root {
-            let d = tree.parent[u as usize];
-            beta[d as usize] = beta[u as usize].max(pc(u, d));
-            mark[d as usize] = i;
-            u = d;
+        let pi_i = pi[i as usize];
+        let mut q = walk.place[i as usize] as usize;
+        beta[q] = Cost::NEG_INFINITY;
+        mark[q] = i;
+        while q != 0 {
+            let d = walk.parent[q] as usize;
+            beta[d] = beta[q].max(walk.up[q]);
+            mark[d] = i;
+            q = d;
         }
         best.clear();
-        for &j in &tree.order {
-            if mark[j as usize] != i {
-                let d = tree.parent[j as usize];
-                beta[j as usize] = beta[d as usize].max(pc(j, d));
+        for q in 0..n {
+            if mark[q] != i {
+                beta[q] = beta[walk.parent[q] as usize].max(walk.up[q]);
             }
+            let j = walk.node[q];
             if j == i {
                 continue;
             }
             let c = arc(i, j);
-            let a = c + pi[i as usize] + pi[j as usize] - beta[j as usize];
+            let a = c + pi_i + walk.pi[q] - beta[q];
             if best.len() == k && !better((a, c, j), best[k - 1]) {
                 continue;
             }
@@ -584,7 +664,7 @@ mod tests {
             let nb = Neighbors::build(&net, n - 1);
             let arc = |a: u32, b: u32| net.arc(a, 0, b, 0);
             let opt = solve_exact(&p).unwrap().unwrap().cost;
-            let mut g = sparse_graph(n, &nb, &arc);
+            let mut g = sparse_graph(&net, &nb, &arc);
             let pi = ascent(&mut g, vec![0.0; n], 200, opt * 1.2, &arc);
             let tree = prim(&mut g, &pi, &arc);
             let bound = tree.cost - 2.0 * pi.iter().sum::<f64>();
@@ -637,7 +717,7 @@ mod tests {
             let opt = solve_exact(&p).unwrap().unwrap().cost;
             let random_pi: Vec<Cost> = (0..n).map(|_| rng.gen_range(-30.0..30.0)).collect();
             let nb = Neighbors::build(&net, 3);
-            let mut g = sparse_graph(n, &nb, &arc);
+            let mut g = sparse_graph(&net, &nb, &arc);
             let ascended = ascent(&mut g, vec![0.0; n], 100, opt * 1.1, &arc);
             for pi in [vec![0.0; n], random_pi, ascended] {
                 let (got, _) = complete_one_tree(&pi, &arc);
@@ -681,6 +761,74 @@ mod tests {
         }
         ratios.sort_by(f64::total_cmp);
         assert!(ratios[ratios.len() / 2] >= 0.97, "median bound/optimum {:?}", ratios);
+    }
+
+    /// On clustered points the nearest lists fall apart into the clusters; the ascent's graph
+    /// is joined by quadrant neighbours into one piece, holds every nearest-list edge, and the
+    /// candidate lists built over it still hold the nearest neighbours. `Pieces` counts as a
+    /// breadth-first search does, and the links added are one fewer than the pieces.
+    #[test]
+    fn the_ascent_graph_of_clusters_is_one_piece() {
+        let mut rng = Pcg64Mcg::seed_from_u64(3);
+        let mut pts = Vec::new();
+        for _ in 0..30 {
+            let (cx, cy) = (rng.gen_range(0.0..10_000.0), rng.gen_range(0.0..10_000.0));
+            for _ in 0..20 {
+                pts.push([cx + rng.gen_range(-10.0..10.0), cy + rng.gen_range(-10.0..10.0), 0.0]);
+            }
+        }
+        let p = crate::search::testing::points_problem(pts);
+        let net = Net::new(&p);
+        let n = net.n;
+        let nb = Neighbors::build(&net, 5);
+        let arc = |a: u32, b: u32| net.arc(a, 0, b, 0);
+        let nearest: Vec<(u32, u32)> =
+            (0..n as u32).flat_map(|v| nb.out(v).iter().flat_map(move |&u| [(v, u), (u, v)])).collect();
+        let bfs_pieces = |edges: &[(u32, u32)]| {
+            let mut adj = vec![Vec::new(); n];
+            for &(a, b) in edges {
+                adj[a as usize].push(b);
+            }
+            let mut seen = vec![false; n];
+            let mut count = 0;
+            for s in 0..n {
+                if seen[s] {
+                    continue;
+                }
+                count += 1;
+                seen[s] = true;
+                let mut stack = vec![s as u32];
+                while let Some(v) = stack.pop() {
+                    for &u in &adj[v as usize] {
+                        if !seen[u as usize] {
+                            seen[u as usize] = true;
+                            stack.push(u);
+                        }
+                    }
+                }
+            }
+            count
+        };
+        let mut p = Pieces::new(n);
+        let apart = n - nearest.iter().filter(|&&(a, b)| p.join(a, b)).count();
+        assert_eq!(apart, bfs_pieces(&nearest));
+        assert!(apart >= 20, "the nearest lists should fall apart into the clusters: {apart} pieces");
+        let g = sparse_graph(&net, &nb, &arc);
+        let joined: Vec<(u32, u32)> = (0..n as u32)
+            .flat_map(|v| g.to[g.off[v as usize] as usize..g.off[v as usize + 1] as usize].iter().map(move |&u| (v, u)))
+            .collect();
+        assert_eq!(bfs_pieces(&joined), 1);
+        let mut unique = nearest.clone();
+        unique.sort_unstable();
+        unique.dedup();
+        assert_eq!(joined.len(), unique.len() + 2 * (apart - 1));
+        assert!(nearest.iter().all(|&(a, b)| g.has_edge(a, b)));
+        let lists = candidates(&net, &nb, 50, 1e9, 2).expect("a symmetric tour");
+        for v in 0..n as u32 {
+            for &u in nb.out(v).iter().take(NEAREST_KEPT) {
+                assert!(lists.out(v).contains(&u), "node {v} lost near neighbour {u}");
+            }
+        }
     }
 
     /// The lists keep the nearest neighbours beside the lowest-α ones, sorted by cost.
