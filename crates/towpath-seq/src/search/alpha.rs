@@ -17,6 +17,7 @@ use std::collections::BinaryHeap;
 
 use super::neighbors::{self, Neighbors};
 use super::net::Net;
+use super::pieces::Pieces;
 use crate::cost::{Cost, CostModel};
 
 /// The sparse graph in compressed rows, with each edge's plain cost.
@@ -284,32 +285,6 @@ fn sparse_graph<C: CostModel>(net: &Net<C>, nb: &Neighbors, arc: &impl Fn(u32, u
 /// Neighbours per quadrant among which the links between pieces are sought.
 const LINK_PER_QUADRANT: usize = 2;
 
-/// Disjoint pieces of a graph's nodes (union–find with path halving).
-struct Pieces(Vec<u32>);
-
-impl Pieces {
-    fn new(n: usize) -> Pieces {
-        Pieces((0..n as u32).collect())
-    }
-
-    fn root(&mut self, mut v: u32) -> u32 {
-        while self.0[v as usize] != v {
-            self.0[v as usize] = self.0[self.0[v as usize] as usize];
-            v = self.0[v as usize];
-        }
-        v
-    }
-
-    /// Joins the pieces of `a` and `b`; false when they were one piece already.
-    fn join(&mut self, a: u32, b: u32) -> bool {
-        let (ra, rb) = (self.root(a), self.root(b));
-        if ra != rb {
-            self.0[ra as usize] = rb;
-        }
-        ra != rb
-    }
-}
-
 /// The graph of directed `edges` (each edge given both ways) in compressed rows.
 fn csr(n: usize, mut edges: Vec<(u32, u32)>, arc: &impl Fn(u32, u32) -> Cost) -> Graph {
     edges.sort_unstable();
@@ -499,7 +474,7 @@ fn lowest_alpha(
     let walk = TreeWalk::new(tree, pi, arc);
     let threads = threads.clamp(1, 64).min(n);
     if threads == 1 {
-        return alpha_rows(0..n as u32, &walk, pi, k, arc);
+        return alpha_rows(0..n as u32, &walk, k, arc);
     }
     let chunk = n.div_ceil(threads) as u32;
     let walk = &walk;
@@ -507,7 +482,7 @@ fn lowest_alpha(
         let handles: Vec<_> = (0..threads as u32)
             .map(|t| {
                 let rows = (t * chunk).min(n as u32)..((t + 1) * chunk).min(n as u32);
-                s.spawn(move || alpha_rows(rows, walk, pi, k, arc))
+                s.spawn(move || alpha_rows(rows, walk, k, arc))
             })
             .collect();
         handles.into_iter().flat_map(|h| h.join().expect("α thread panicked")).collect()
@@ -552,13 +527,7 @@ impl TreeWalk {
 /// Candidate lists of the nodes in `rows`. β(i,j), the dearest tree edge on the path from i to
 /// j, comes for every j in one pass over the tree in Prim's order (parents first) after marking
 /// i's path to the root.
-fn alpha_rows(
-    rows: std::ops::Range<u32>,
-    walk: &TreeWalk,
-    pi: &[Cost],
-    k: usize,
-    arc: &impl Fn(u32, u32) -> Cost,
-) -> Vec<Vec<u32>> {
+fn alpha_rows(rows: std::ops::Range<u32>, walk: &TreeWalk, k: usize, arc: &impl Fn(u32, u32) -> Cost) -> Vec<Vec<u32>> {
     let n = walk.node.len();
     let k = k.min(n - 1);
     let mut beta = vec![Cost::NEG_INFINITY; n];
@@ -566,8 +535,8 @@ fn alpha_rows(
     let mut lists = Vec::with_capacity(rows.len());
     let mut best: Vec<(Cost, Cost, u32)> = Vec::with_capacity(k + 1);
     for i in rows {
-        let pi_i = pi[i as usize];
         let mut q = walk.place[i as usize] as usize;
+        let pi_i = walk.pi[q];
         beta[q] = Cost::NEG_INFINITY;
         mark[q] = i;
         while q != 0 {

@@ -11,6 +11,7 @@
 //! adopting the better tour would throw one away.
 
 use super::net::Net;
+use super::pieces::Pieces;
 use super::tour::Tour;
 use crate::cost::{Cost, CostModel};
 
@@ -51,33 +52,22 @@ pub(crate) fn partition_crossover<C: CostModel>(
         return None;
     }
     // Their components (union-find over the end nodes) and each component's gain.
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn find(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            let up = parent[parent[x as usize] as usize];
-            parent[x as usize] = up;
-            x = up;
-        }
-        x
-    }
+    let mut pieces = Pieces::new(n);
     let mut in_comp = vec![false; n];
     for &(u, v, _) in &unshared {
-        let (ru, rv) = (find(&mut parent, u), find(&mut parent, v));
-        if ru != rv {
-            parent[ru as usize] = rv;
-        }
+        pieces.join(u, v);
         in_comp[u as usize] = true;
         in_comp[v as usize] = true;
     }
     let mut gain: Vec<Cost> = vec![0.0; n];
     for &(u, v, sign) in &unshared {
-        let r = find(&mut parent, u) as usize;
+        let r = pieces.root(u) as usize;
         gain[r] += sign * cost(u, v);
     }
     let mut members: Vec<Vec<u32>> = vec![Vec::new(); n];
     for v in 0..n as u32 {
         if in_comp[v as usize] {
-            let r = find(&mut parent, v) as usize;
+            let r = pieces.root(v) as usize;
             members[r].push(v);
         }
     }

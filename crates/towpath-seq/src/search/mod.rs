@@ -11,6 +11,7 @@ mod modes;
 mod neighbors;
 mod net;
 mod patching;
+mod pieces;
 mod population;
 mod reversible;
 mod sop3;
