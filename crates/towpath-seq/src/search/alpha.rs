@@ -10,7 +10,8 @@
 //!
 //! Used for symmetric one-mode closed tours (TSP). The ascent works on a sparse graph (the
 //! nearest-neighbour lists, both ways, joined where they fall apart); the α-values are exact
-//! for that tree, over all node pairs (O(n²) arc evaluations per run).
+//! for that tree, over all node pairs (an O(n²) pass, which on planar points prices only the
+//! pairs close enough to enter a list).
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -18,7 +19,7 @@ use std::collections::BinaryHeap;
 use super::neighbors::{self, Neighbors};
 use super::net::Net;
 use super::pieces::Pieces;
-use crate::cost::{Cost, CostModel};
+use crate::cost::{Cost, CostModel, PlanarEuclid};
 
 /// The sparse graph in compressed rows, with each edge's plain cost.
 struct Graph {
@@ -134,7 +135,7 @@ pub(crate) fn candidates<C: CostModel>(
     let mut g = sparse_graph(net, nb, &arc);
     let pi = ascent(&mut g, vec![0.0; n], steps, ub, &arc);
     let tree = prim(&mut g, &pi, &arc);
-    let mut lists = lowest_alpha(n, &tree, &pi, ALPHA_K, threads, &arc);
+    let mut lists = lowest_alpha(net, nb, &tree, &pi, ALPHA_K, threads, &arc);
     // add the nearest, then order by cost (the one sort the lists get)
     for (v, list) in lists.iter_mut().enumerate() {
         let v = v as u32;
@@ -462,9 +463,12 @@ fn ascent(g: &mut Graph, start: Vec<Cost>, steps: usize, ub: Cost, arc: &impl Fn
 }
 
 /// The `k` lowest-α neighbours of every node, lowest α first, computed on `threads` threads
-/// (the answer does not depend on how many).
-fn lowest_alpha(
-    n: usize,
+/// (the answer does not depend on how many). Planar points are copied into the tree walk's
+/// order, so that the pass reads them front to back, and most pairs are ruled out by their
+/// squared distance alone (see [`PlacedCost`]).
+fn lowest_alpha<C: CostModel>(
+    net: &Net<C>,
+    nb: &Neighbors,
     tree: &Tree,
     pi: &[Cost],
     k: usize,
@@ -472,17 +476,106 @@ fn lowest_alpha(
     arc: &(impl Fn(u32, u32) -> Cost + Sync),
 ) -> Vec<Vec<u32>> {
     let walk = TreeWalk::new(tree, pi, arc);
+    let walk = &walk;
+    // the places of a node's nearest neighbours and of its parent in the tree
+    let near = |at: u32| {
+        let v = walk.node[at as usize];
+        let mut near: Vec<u32> = nb.out(v).iter().map(|&u| walk.place[u as usize]).collect();
+        near.push(walk.parent[at as usize]);
+        // each place once: a place counted twice would make the bound too low
+        near.sort_unstable();
+        near.dedup();
+        near
+    };
+    match net.planar() {
+        Some(pl) => {
+            let placed = PlacedPoints {
+                points: PlanarEuclid {
+                    xy: walk.node.iter().map(|&v| pl.xy[v as usize]).collect(),
+                    rounding: pl.rounding,
+                },
+                forbidden: net.forbidden,
+            };
+            split_rows(walk, k, threads, &near, &placed)
+        }
+        None => split_rows(walk, k, threads, &near, &PlacedArcs { walk, arc }),
+    }
+}
+
+/// Costs between places of the tree walk, for the α pass.
+trait PlacedCost: Sync {
+    /// The cost between the nodes at places `a` and `b`.
+    fn cost(&self, a: u32, b: u32) -> Cost;
+
+    /// True only if the cost between places `a` and `b` is surely above `room`; false when it
+    /// cannot tell cheaply.
+    fn surely_above(&self, a: u32, b: u32, room: Cost) -> bool;
+}
+
+/// Any costs, through the net's arcs.
+struct PlacedArcs<'a, F> {
+    walk: &'a TreeWalk,
+    arc: &'a F,
+}
+
+impl<F: Fn(u32, u32) -> Cost + Sync> PlacedCost for PlacedArcs<'_, F> {
+    #[inline(always)]
+    fn cost(&self, a: u32, b: u32) -> Cost {
+        (self.arc)(self.walk.node[a as usize], self.walk.node[b as usize])
+    }
+
+    #[inline(always)]
+    fn surely_above(&self, _: u32, _: u32, _: Cost) -> bool {
+        false
+    }
+}
+
+/// Rounded distances in a plane, the points in the walk's order.
+struct PlacedPoints {
+    points: PlanarEuclid,
+    /// The net's price of a forbidden arc, which caps every arc.
+    forbidden: Cost,
+}
+
+impl PlacedCost for PlacedPoints {
+    #[inline(always)]
+    fn cost(&self, a: u32, b: u32) -> Cost {
+        self.points.cost(a as usize, b as usize).min(self.forbidden)
+    }
+
+    /// Every rounding gives at least the distance less ½, so a squared distance above
+    /// (room + 1)² (with a margin for the sums' rounding) settles it without a square root.
+    #[inline(always)]
+    fn surely_above(&self, a: u32, b: u32, room: Cost) -> bool {
+        if room >= self.forbidden {
+            return false;
+        }
+        let (p, q) = (self.points.xy[a as usize], self.points.xy[b as usize]);
+        let (dx, dy) = (p[0] - q[0], p[1] - q[1]);
+        let reach = room + 1.0 + 1e-9 * room.abs();
+        reach < 0.0 || dx * dx + dy * dy > reach * reach
+    }
+}
+
+/// [`alpha_rows`] of every node, the rows split between `threads` threads.
+fn split_rows(
+    walk: &TreeWalk,
+    k: usize,
+    threads: usize,
+    near: &(impl Fn(u32) -> Vec<u32> + Sync),
+    cost: &impl PlacedCost,
+) -> Vec<Vec<u32>> {
+    let n = walk.node.len();
     let threads = threads.clamp(1, 64).min(n);
     if threads == 1 {
-        return alpha_rows(0..n as u32, &walk, k, arc);
+        return alpha_rows(0..n as u32, walk, k, near, cost);
     }
     let chunk = n.div_ceil(threads) as u32;
-    let walk = &walk;
     std::thread::scope(|s| {
         let handles: Vec<_> = (0..threads as u32)
             .map(|t| {
                 let rows = (t * chunk).min(n as u32)..((t + 1) * chunk).min(n as u32);
-                s.spawn(move || alpha_rows(rows, walk, k, arc))
+                s.spawn(move || alpha_rows(rows, walk, k, near, cost))
             })
             .collect();
         handles.into_iter().flat_map(|h| h.join().expect("α thread panicked")).collect()
@@ -524,18 +617,28 @@ impl TreeWalk {
     }
 }
 
-/// Candidate lists of the nodes in `rows`. β(i,j), the dearest tree edge on the path from i to
-/// j, comes for every j in one pass over the tree in Prim's order (parents first) after marking
-/// i's path to the root.
-fn alpha_rows(rows: std::ops::Range<u32>, walk: &TreeWalk, k: usize, arc: &impl Fn(u32, u32) -> Cost) -> Vec<Vec<u32>> {
+/// Candidate lists of the nodes in `rows`; `cost` prices two places of the walk and `near`
+/// gives a few places near each node's. β(i,j), the dearest tree edge on the path from i to j,
+/// comes for every j in one pass over the tree in Prim's order (parents first) after marking
+/// i's path to the root. The k-th lowest α among the near places bounds the list from the
+/// start, so that the scan of all pairs prices only the few that can enter it.
+fn alpha_rows(
+    rows: std::ops::Range<u32>,
+    walk: &TreeWalk,
+    k: usize,
+    near: &(impl Fn(u32) -> Vec<u32> + Sync),
+    cost: &impl PlacedCost,
+) -> Vec<Vec<u32>> {
     let n = walk.node.len();
     let k = k.min(n - 1);
     let mut beta = vec![Cost::NEG_INFINITY; n];
     let mut mark = vec![u32::MAX; n];
     let mut lists = Vec::with_capacity(rows.len());
     let mut best: Vec<(Cost, Cost, u32)> = Vec::with_capacity(k + 1);
+    let mut seed: Vec<Cost> = Vec::new();
     for i in rows {
-        let mut q = walk.place[i as usize] as usize;
+        let at = walk.place[i as usize];
+        let mut q = at as usize;
         let pi_i = walk.pi[q];
         beta[q] = Cost::NEG_INFINITY;
         mark[q] = i;
@@ -545,23 +648,43 @@ fn alpha_rows(rows: std::ops::Range<u32>, walk: &TreeWalk, k: usize, arc: &impl 
             mark[d] = i;
             q = d;
         }
+        for q in 1..n {
+            if mark[q] != i {
+                let (b, u) = (beta[walk.parent[q] as usize], walk.up[q]);
+                beta[q] = if u > b { u } else { b };
+            }
+        }
+        let alpha = |q: usize, c: Cost| c + pi_i + walk.pi[q] - beta[q];
+        // the k-th lowest α so far, first among the near places: a pair above it cannot enter
+        seed.clear();
+        seed.extend(near(at).into_iter().filter(|&q| q != at).map(|q| alpha(q as usize, cost.cost(at, q))));
+        let mut worst =
+            if seed.len() >= k { *seed.select_nth_unstable_by(k - 1, |x, y| x.total_cmp(y)).1 } else { Cost::INFINITY };
         best.clear();
         for q in 0..n {
-            if mark[q] != i {
-                beta[q] = beta[walk.parent[q] as usize].max(walk.up[q]);
-            }
-            let j = walk.node[q];
-            if j == i {
+            if q == at as usize {
                 continue;
             }
-            let c = arc(i, j);
-            let a = c + pi_i + walk.pi[q] - beta[q];
+            // the dearest cost with which the pair could still enter
+            let room = worst - pi_i - walk.pi[q] + beta[q];
+            if cost.surely_above(at, q as u32, room) {
+                continue;
+            }
+            let c = cost.cost(at, q as u32);
+            let a = alpha(q, c);
+            if a > worst {
+                continue;
+            }
+            let j = walk.node[q];
             if best.len() == k && !better((a, c, j), best[k - 1]) {
                 continue;
             }
-            let at = best.iter().position(|&b| better((a, c, j), b)).unwrap_or(best.len());
-            best.insert(at, (a, c, j));
+            let slot = best.iter().position(|&b| better((a, c, j), b)).unwrap_or(best.len());
+            best.insert(slot, (a, c, j));
             best.truncate(k);
+            if best.len() == k {
+                worst = worst.min(best[k - 1].0);
+            }
         }
         lists.push(best.iter().map(|b| b.2).collect());
     }
@@ -643,7 +766,7 @@ mod tests {
             let pc = |a: u32, b: u32| arc(a, b) + pi[a as usize] + pi[b as usize];
             let mst = forced_mst(n, &pc, None);
             let k = 4;
-            let lists = lowest_alpha(n, &tree, &pi, k, 2, &arc);
+            let lists = lowest_alpha(&net, &nb, &tree, &pi, k, 2, &arc);
             for i in 0..n as u32 {
                 let mut want: Vec<(Cost, Cost, u32)> = (0..n as u32)
                     .filter(|&j| j != i)
@@ -736,6 +859,46 @@ mod tests {
     /// is joined by quadrant neighbours into one piece, holds every nearest-list edge, and the
     /// candidate lists built over it still hold the nearest neighbours. `Pieces` counts as a
     /// breadth-first search does, and the links added are one fewer than the pieces.
+    #[test]
+    fn the_pruned_planar_pass_gives_the_lists_of_the_full_one() {
+        // clustered points, more than the arc table holds (so the arcs are planar distances),
+        // under each rounding: the pass that prices pairs from the walk's copy of the points,
+        // skips them by squared distance and starts from a bound must give the same lists as
+        // pricing every pair through the net's arcs with no bound
+        use crate::cost::Metric;
+        for (seed, metric) in [(1, Metric::Euclidean), (2, Metric::EuclideanNint), (3, Metric::EuclideanCeil)] {
+            let mut rng = Pcg64Mcg::seed_from_u64(seed);
+            let mut pts = Vec::new();
+            for _ in 0..24 {
+                let (cx, cy) = (rng.gen_range(0.0..5_000.0), rng.gen_range(0.0..5_000.0));
+                for _ in 0..50 {
+                    pts.push([cx + rng.gen_range(-60.0..60.0), cy + rng.gen_range(-60.0..60.0), 0.0]);
+                }
+            }
+            let n = pts.len();
+            let mut b = Problem::builder(PointCost::new(pts, metric));
+            for v in 0..n as u32 {
+                b.task(vec![crate::model::Mode::point(crate::cost::StateId(v))]);
+            }
+            let p = b.build().expect("a point per task");
+            let net = Net::new(&p);
+            assert!(net.planar().is_some(), "{metric:?}: no planar arcs at {n} points");
+            let nb = Neighbors::build(&net, 10);
+            let arc = |a: u32, b: u32| net.arc(a, 0, b, 0);
+            let mut g = sparse_graph(&net, &nb, &arc);
+            let tour: Cost = (0..n as u32).map(|v| arc(v, (v + 1) % n as u32)).sum();
+            let pi = ascent(&mut g, vec![0.0; n], 30, tour, &arc);
+            let tree = prim(&mut g, &pi, &arc);
+            let fast = lowest_alpha(&net, &nb, &tree, &pi, ALPHA_K, 2, &arc);
+            let walk = TreeWalk::new(&tree, &pi, &arc);
+            let full = split_rows(&walk, ALPHA_K, 1, &|_| Vec::new(), &PlacedArcs { walk: &walk, arc: &arc });
+            assert_eq!(fast.len(), n);
+            for v in 0..n {
+                assert_eq!(fast[v], full[v], "{metric:?}: node {v}");
+            }
+        }
+    }
+
     #[test]
     fn the_ascent_graph_of_clusters_is_one_piece() {
         let mut rng = Pcg64Mcg::seed_from_u64(3);

@@ -314,13 +314,13 @@ fn search<C: CostModel>(
         let cost = check(problem, &steps).map_err(SolveError::NoFeasibleRoute)?;
         return Ok(SolveReport::proven(Solution { steps, cost }, initial_cost, t0));
     }
-    // Where the candidate lists do not depend on the starts (no α pass), large plain tours
-    // build them first and start from a nearest-neighbour tour through them.
-    let early_lists = lists_before_starts(&net, opts, threads).then(|| candidate_lists(&net, &[], opts, threads));
-    let mut starts = if let Some(nb) = &early_lists {
-        let first = construct::seed_pool(&net, 1).first().copied().unwrap_or(net.anchor);
+    // Large plain tours build their lists first and start from a nearest-neighbour tour
+    // through them (through the nearest lists when the α pass needs a tour's cost).
+    let early = lists_before_starts(&net).then(|| lists_and_start(&net, opts, threads));
+    let (early_lists, early_start) = early.unzip();
+    let mut starts = if let Some(start) = early_start {
         let mut starts: Vec<Tour> = assigned.map(|a| a.tour).into_iter().collect();
-        starts.push(Tour::new(&net, construct::nearest_neighbor_by_lists(&net, nb, first), vec![0; net.n]));
+        starts.push(start);
         starts
     } else if !net.partner.is_empty() && opts.initial.is_some() {
         // Constructed tours through the ends of two-way tasks are poor starts beside a given
@@ -518,28 +518,65 @@ fn construct_starts<C: CostModel>(
     starts
 }
 
-/// Smallest plain tour that starts from a nearest-neighbour tour through its candidate lists
-/// (when the lists need no start, see [`lists_before_starts`]) instead of the full, quadratic
-/// one: from here one tour of the seed pool is all a 10 s limit affords, and at 10,000 points
+/// Smallest plain tour that starts from a nearest-neighbour tour through lists (see
+/// [`lists_before_starts`]) instead of the full, quadratic one: from here one tour of the seed pool is all a 10 s limit affords, and at 10,000 points
 /// its scan took about 1.2 s of the limit while the other threads waited.
 const LIST_START_FROM: usize = 4_000;
 
 /// True when the candidate lists are built before the starts, and the start is the nearest
-/// neighbour through them: plain symmetric one-mode tours (no precedence, groups or fixed
-/// edges, no fixed start) of [`LIST_START_FROM`] to [`SPACE_FILLING_FROM`] nodes whose lists
-/// take no α pass (the only kind of list that needs a start: its ascent's step length uses a
-/// tour's cost).
-fn lists_before_starts<C: CostModel>(net: &Net<C>, opts: &SolveOptions, threads: usize) -> bool {
-    (LIST_START_FROM..=SPACE_FILLING_FROM).contains(&net.n)
-        && local::plain_tour(net)
-        && net.depot == u32::MAX
-        && alpha::plan(net.n, threads, opts.time_limit.map(|d| d.as_secs_f64())).is_none()
+/// neighbour through them (see [`lists_and_start`]): plain symmetric one-mode tours (no
+/// precedence, groups or fixed edges, no fixed start) of [`LIST_START_FROM`] to
+/// [`SPACE_FILLING_FROM`] nodes.
+fn lists_before_starts<C: CostModel>(net: &Net<C>) -> bool {
+    (LIST_START_FROM..=SPACE_FILLING_FROM).contains(&net.n) && local::plain_tour(net) && net.depot == u32::MAX
+}
+
+/// The candidate lists and a nearest-neighbour tour through lists: through the candidate
+/// lists themselves, or, when they take an α pass (whose ascent's step length needs a tour's
+/// cost), through the nearest lists, which the pass then starts from.
+fn lists_and_start<C: CostModel>(net: &Net<C>, opts: &SolveOptions, threads: usize) -> (Neighbors, Tour) {
+    let first = construct::seed_pool(net, 1).first().copied().unwrap_or(net.anchor);
+    let through = |nb: &Neighbors| Tour::new(net, construct::nearest_neighbor_by_lists(net, nb, first), vec![0; net.n]);
+    if alpha_plan(net, opts, threads).is_none() {
+        let nb = candidate_lists(net, &[], opts, threads);
+        let start = through(&nb);
+        return (nb, start);
+    }
+    let nearest = Neighbors::build(net, list_length(net));
+    let start = through(&nearest);
+    let nb = plain_candidate_lists(net, std::slice::from_ref(&start), opts, threads, Some(nearest));
+    (nb, start)
+}
+
+/// The ascent steps of the α pass (see `alpha::plan`) when the lists take one.
+fn alpha_plan<C: CostModel>(net: &Net<C>, opts: &SolveOptions, threads: usize) -> Option<usize> {
+    alpha::plan(net.n, threads, opts.time_limit.map(|d| d.as_secs_f64())).filter(|_| net.partner.is_empty())
+}
+
+/// Length of the nearest-neighbour lists.
+fn list_length<C: CostModel>(net: &Net<C>) -> usize {
+    // Wider lists pay off under precedence (measured on TSPLIB SOP and SOPLIB at equal time: 16
+    // beat 10 and 24).
+    let k: usize = if net.n > 20_000 {
+        8
+    } else if net.has_prec {
+        16
+    } else {
+        10
+    };
+    // The two ends of a short two-way task lie close together and take two places in every
+    // list near them: twice as many places keep as many tasks.
+    if net.partner.is_empty() {
+        k
+    } else {
+        LIST_FACTOR_ENDS * k
+    }
 }
 
 /// The candidate neighbours of each node (see [`plain_candidate_lists`]), each node's fixed
 /// partner first where there are fixed edges (see `two_way`).
 fn candidate_lists<C: CostModel>(net: &Net<C>, starts: &[Tour], opts: &SolveOptions, threads: usize) -> Neighbors {
-    let nb = plain_candidate_lists(net, starts, opts, threads);
+    let nb = plain_candidate_lists(net, starts, opts, threads, None);
     if net.partner.is_empty() {
         nb
     } else {
@@ -555,23 +592,12 @@ fn plain_candidate_lists<C: CostModel>(
     starts: &[Tour],
     opts: &SolveOptions,
     threads: usize,
+    nearest: Option<Neighbors>,
 ) -> Neighbors {
-    // Wider lists pay off under precedence (measured on TSPLIB SOP and SOPLIB at equal time: 16
-    // beat 10 and 24).
-    let k: usize = if net.n > 20_000 {
-        8
-    } else if net.has_prec {
-        16
-    } else {
-        10
-    };
-    // The two ends of a short two-way task lie close together and take two places in every
-    // list near them: twice as many places keep as many tasks.
-    let k = if net.partner.is_empty() { k } else { LIST_FACTOR_ENDS * k };
+    let k = list_length(net);
     // Not α on two-way tasks' ends: on 1,500 short strokes its lists left a 420-unit arc that
     // a 2-opt move removes (the fixed edges distort the 1-trees); quadrant lists left none.
-    let alpha_steps =
-        alpha::plan(net.n, threads, opts.time_limit.map(|d| d.as_secs_f64())).filter(|_| net.partner.is_empty());
+    let alpha_steps = alpha_plan(net, opts, threads);
     // Without α, nearest lists miss the arcs between clusters; quadrant neighbours keep them.
     // gauss-10000 (100 clusters, 10 s, seeds 1-2): 1,588,315 / 1,572,931 -> 1,539,073 /
     // 1,540,787 (fast-tsp 1,545,361 / 1,545,751); uniform 20,000 and portc-10000 within 0.06 %.
@@ -588,7 +614,7 @@ fn plain_candidate_lists<C: CostModel>(
             return lists;
         }
     }
-    let nb = Neighbors::build(net, k);
+    let nb = nearest.unwrap_or_else(|| Neighbors::build(net, k));
     if let Some(steps) = alpha_steps {
         let ub = starts.iter().map(|t| t.cost).fold(Cost::INFINITY, Cost::min);
         if let Some(lists) = alpha::candidates(net, &nb, steps, ub, threads) {
@@ -964,22 +990,26 @@ mod tests {
         }
     }
 
-    /// Plain tours of 4,000 to 12,000 points start from the nearest neighbour through their
-    /// lists when those take no α pass (without a time limit: above 8,000 points), and such a
-    /// solve is deterministic and checked.
+    /// Plain tours of 4,000 to 12,000 points start from the nearest neighbour through lists:
+    /// their candidate lists (quadrant lists: without a time limit above 8,000 points) or, when
+    /// those take an α pass, the nearest lists, whose tour gives the ascent its step length;
+    /// such a solve is deterministic and checked.
     #[test]
     fn large_plain_tours_start_from_their_lists() {
-        let p = random_tour_problem(&mut Pcg64Mcg::seed_from_u64(5), 8_500, 10_000.0);
-        let net = Net::new(&p);
         let worked = SolveOptions { time_limit: None, iterations: Some(200), threads: 2, ..Default::default() };
-        assert!(lists_before_starts(&net, &worked, 2));
         let small = random_tour_problem(&mut Pcg64Mcg::seed_from_u64(5), 3_000, 10_000.0);
-        assert!(!lists_before_starts(&Net::new(&small), &worked, 2));
-        let a = solve(&p, &worked).expect("solves");
-        let b = solve(&p, &worked).expect("solves");
-        assert_eq!(a.solution.steps, b.solution.steps);
-        assert_eq!(a.solution.steps.len(), 8_500);
-        let cost = check(&p, &a.solution.steps).expect("feasible");
-        assert!((cost - a.solution.cost).abs() < 1e-6 * cost);
+        assert!(!lists_before_starts(&Net::new(&small)));
+        for (n, alpha) in [(4_500, true), (8_500, false)] {
+            let p = random_tour_problem(&mut Pcg64Mcg::seed_from_u64(5), n, 10_000.0);
+            let net = Net::new(&p);
+            assert!(lists_before_starts(&net));
+            assert_eq!(alpha_plan(&net, &worked, 2).is_some(), alpha, "{n} points");
+            let a = solve(&p, &worked).expect("solves");
+            let b = solve(&p, &worked).expect("solves");
+            assert_eq!(a.solution.steps, b.solution.steps);
+            assert_eq!(a.solution.steps.len(), n);
+            let cost = check(&p, &a.solution.steps).expect("feasible");
+            assert!((cost - a.solution.cost).abs() < 1e-6 * cost, "{n} points");
+        }
     }
 }

@@ -335,6 +335,12 @@ impl<'p, C: CostModel> Net<'p, C> {
         self.arc_by_model(a, ma, b, mb)
     }
 
+    /// The points of a plane whose rounded distances are the arcs (clamped to
+    /// [`Net::forbidden`]), when there is no table and the costs are such distances.
+    pub(crate) fn planar(&self) -> Option<&PlanarEuclid> {
+        self.planar.as_ref()
+    }
+
     /// [`Net::arc`] through the cost model (kept out of line so that the table and planar
     /// paths inline into the search's loops).
     #[inline(never)]
