@@ -519,8 +519,9 @@ fn construct_starts<C: CostModel>(
 }
 
 /// Smallest plain tour that starts from a nearest-neighbour tour through lists (see
-/// [`lists_before_starts`]) instead of the full, quadratic one: from here one tour of the seed pool is all a 10 s limit affords, and at 10,000 points
-/// its scan took about 1.2 s of the limit while the other threads waited.
+/// [`lists_before_starts`]) instead of the full, quadratic one: from here one tour of the seed
+/// pool is all a 10 s limit affords, and at 10,000 points its scan took about 1.2 s of the
+/// limit while the other threads waited.
 const LIST_START_FROM: usize = 4_000;
 
 /// True when the candidate lists are built before the starts, and the start is the nearest
