@@ -855,10 +855,6 @@ mod tests {
         assert!(ratios[ratios.len() / 2] >= 0.97, "median bound/optimum {:?}", ratios);
     }
 
-    /// On clustered points the nearest lists fall apart into the clusters; the ascent's graph
-    /// is joined by quadrant neighbours into one piece, holds every nearest-list edge, and the
-    /// candidate lists built over it still hold the nearest neighbours. `Pieces` counts as a
-    /// breadth-first search does, and the links added are one fewer than the pieces.
     #[test]
     fn the_pruned_planar_pass_gives_the_lists_of_the_full_one() {
         // clustered points, more than the arc table holds (so the arcs are planar distances),
@@ -899,6 +895,10 @@ mod tests {
         }
     }
 
+    /// On clustered points the nearest lists fall apart into the clusters; the ascent's graph
+    /// is joined by quadrant neighbours into one piece, holds every nearest-list edge, and the
+    /// candidate lists built over it still hold the nearest neighbours. `Pieces` counts as a
+    /// breadth-first search does, and the links added are one fewer than the pieces.
     #[test]
     fn the_ascent_graph_of_clusters_is_one_piece() {
         let mut rng = Pcg64Mcg::seed_from_u64(3);
