@@ -89,6 +89,14 @@ const MAX_ASCENT: usize = 300;
 
 /// Estimated time of one ascent step per node (a heap-based Prim over ~13 edges a node) and of
 /// one α pair (a cost and a tree step), used to decide whether the lists fit the budget.
+///
+/// Since the pruned pass (see [`lowest_alpha`]) a pair costs about 9 ns, not 15, but the
+/// estimate was kept on purpose: it sets where α lists stop and how many steps the ascent
+/// gets, and both were measured best as they are. With 9 ns, gauss-5000 (60 clusters) would
+/// get 110 steps instead of 89 and gauss-10000 (100 clusters) α lists instead of quadrant
+/// lists; on three instances of each (10 s, two threads, 6-20 seeds) 110 steps gave the worse
+/// median on all three and α lists at 10,000 points on two of three (BENCHMARKS.md,
+/// fourteenth round).
 const STEP_SECONDS_PER_NODE: f64 = 7e-7;
 const PAIR_SECONDS: f64 = 1.5e-8;
 
@@ -742,6 +750,38 @@ mod tests {
             }
         }
         total
+    }
+
+    /// The plan gives α lists only when the estimated pass fits its share of the limit, with
+    /// as many ascent steps as fit the rest, up to [`MAX_ASCENT`]; without a limit, up to
+    /// [`MAX_NODES`] nodes.
+    #[test]
+    fn the_plan_fits_the_pass_in_its_share() {
+        for n in (500..=30_000).step_by(500) {
+            for threads in 1..=4 {
+                for seconds in [1.0, 3.0, 10.0, 30.0, 60.0] {
+                    let pass = (n as f64).powi(2) * PAIR_SECONDS / threads as f64;
+                    let budget = seconds * TIME_SHARE;
+                    let at = format!("{n} nodes, {threads} threads, {seconds} s");
+                    match plan(n, threads, Some(seconds)) {
+                        None => assert!(pass > budget, "{at}"),
+                        Some(steps) => {
+                            assert!(pass <= budget, "{at}");
+                            let rest = (budget - pass) / (n as f64 * STEP_SECONDS_PER_NODE);
+                            assert!(steps <= MAX_ASCENT, "{at}");
+                            assert!(steps as f64 <= rest && (steps == MAX_ASCENT || rest < steps as f64 + 1.0), "{at}");
+                        }
+                    }
+                }
+            }
+        }
+        // the sizes the benchmarks rely on (two threads, 10 s): 2,000 points take the whole
+        // ascent, 5,000 a shorter one, 10,000 quadrant lists
+        assert_eq!(plan(2_000, 2, Some(10.0)), Some(MAX_ASCENT));
+        assert_eq!(plan(5_000, 2, Some(10.0)), Some(89));
+        assert_eq!(plan(10_000, 2, Some(10.0)), None);
+        assert_eq!(plan(MAX_NODES, 1, None), Some(MAX_ASCENT));
+        assert_eq!(plan(MAX_NODES + 1, 8, None), None);
     }
 
     /// The ascent's bound never exceeds the optimal tour (it is a Held–Karp lower bound), and
