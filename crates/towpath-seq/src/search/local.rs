@@ -2,7 +2,8 @@
 //! chains of 2-opt reversals (reversal-symmetric tours, also under precedence) or, on plain
 //! symmetric one-mode tours, of sequential 3-opt moves (`lk3`); Or-opt (segments of 1–3 tasks
 //! and whole group blocks, optionally reversed); and the segment exchange (path-preserving
-//! 3-opt). Moves respect precedence (checked incrementally by marking the moved segment's
+//! 3-opt); where tasks have modes but no chains run, reversals of short stretches with their
+//! modes chosen afresh (`window_flip`). Moves respect precedence (checked incrementally by marking the moved segment's
 //! successors or predecessors while scanning outwards) and consecutive groups (see
 //! [`Net::move_allowed`]).
 
@@ -16,6 +17,7 @@ use super::tour::Tour;
 use crate::cost::{Cost, CostModel};
 
 pub(crate) mod lk3;
+mod window_flip;
 
 /// Longest segment Or-opt moves.
 const MAX_SEGMENT: usize = 3;
@@ -107,6 +109,8 @@ pub(crate) struct LocalSearch<'a, 'p, C> {
     pub breadth1: usize,
     /// The exhaustive SOP-3-exchange, where it applies (see `sop3::applies`).
     sop3: Option<Sop3>,
+    /// Short reversals with their modes chosen afresh (see `window_flip`).
+    flip: bool,
 }
 
 /// Whether Or-opt and the segment exchange apply the positive-gain criterion: a move whose
@@ -149,6 +153,7 @@ struct Insertion {
 impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
     pub fn new(net: &'a Net<'p, C>, nb: &'a Neighbors, eps: Cost) -> Self {
         let or3 = uses_or3(net);
+        let two_opt = net.reversal_symmetric && (!net.has_prec || !net.multi_mode);
         LocalSearch {
             net,
             nb,
@@ -157,7 +162,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             queued: vec![false; net.n],
             mark: vec![0; net.n],
             stamp: 0,
-            two_opt: net.reversal_symmetric && (!net.has_prec || !net.multi_mode),
+            two_opt,
             scan_limit: SCAN_RADIUS,
             deadline: None,
             cut: false,
@@ -175,6 +180,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             lk3_removed: Vec::new(),
             breadth1: 1,
             sop3: sop3::applies(net).then(|| Sop3::new(net.n)),
+            flip: window_flip::applies(net, two_opt),
         }
     }
 
@@ -267,6 +273,9 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             return false;
         }
         if self.try_or_opt(tour, v) || self.try_swap(tour, v) {
+            return true;
+        }
+        if self.flip && self.try_flip_window(tour, v) {
             return true;
         }
         // the candidate-list moves first (cheap), then the whole 3-exchange neighbourhood

@@ -543,7 +543,7 @@ fn lists_and_start<C: CostModel>(net: &Net<C>, opts: &SolveOptions, threads: usi
         let start = through(&nb);
         return (nb, start);
     }
-    let nearest = Neighbors::build(net, list_length(net));
+    let nearest = Neighbors::build_on(net, list_length(net), threads);
     let start = through(&nearest);
     let nb = plain_candidate_lists(net, std::slice::from_ref(&start), opts, threads, Some(nearest));
     (nb, start)
@@ -615,7 +615,7 @@ fn plain_candidate_lists<C: CostModel>(
             return lists;
         }
     }
-    let nb = nearest.unwrap_or_else(|| Neighbors::build(net, k));
+    let nb = nearest.unwrap_or_else(|| Neighbors::build_on(net, k, threads));
     if let Some(steps) = alpha_steps {
         let ub = starts.iter().map(|t| t.cost).fold(Cost::INFINITY, Cost::min);
         if let Some(lists) = alpha::candidates(net, &nb, steps, ub, threads) {
