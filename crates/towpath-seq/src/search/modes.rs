@@ -32,20 +32,7 @@ pub(crate) fn optimize_modes_noting<C: CostModel>(
     for m0 in 0..net.num_modes(a0) {
         f.iter_mut().for_each(|x| *x = Cost::INFINITY);
         f[m0 as usize] = net.mode_cost(a0, m0);
-        for i in 1..n {
-            let (u, v) = (tour.seq[i - 1], tour.seq[i]);
-            for mv in 0..net.num_modes(v) {
-                let mut best = (Cost::INFINITY, 0u32);
-                for mu in 0..net.num_modes(u) {
-                    let c = f[(i - 1) * mm + mu as usize] + net.arc(u, mu, v, mv);
-                    if c < best.0 {
-                        best = (c, mu);
-                    }
-                }
-                f[i * mm + mv as usize] = best.0 + net.mode_cost(v, mv);
-                par[i * mm + mv as usize] = best.1;
-            }
-        }
+        relax_layers(net, &tour.seq, mm, &mut f, &mut par);
         let last = tour.seq[n - 1];
         for ml in 0..net.num_modes(last) {
             let c = f[(n - 1) * mm + ml as usize] + net.arc(last, ml, a0, m0);
@@ -73,5 +60,26 @@ pub(crate) fn optimize_modes_noting<C: CostModel>(
         true
     } else {
         false
+    }
+}
+
+/// The layers after the first of the mode graph along `seq`: given `f`'s first row (the cost of
+/// reaching `seq[0]` in each mode), fills row i with the cheapest cost of reaching `seq[i]` in
+/// each mode (mode costs included) and `par`'s row i with the mode of `seq[i - 1]` on that
+/// path. Rows are `mm` wide.
+pub(crate) fn relax_layers<C: CostModel>(net: &Net<C>, seq: &[u32], mm: usize, f: &mut [Cost], par: &mut [u32]) {
+    for i in 1..seq.len() {
+        let (u, v) = (seq[i - 1], seq[i]);
+        for mv in 0..net.num_modes(v) {
+            let mut best = (Cost::INFINITY, 0u32);
+            for mu in 0..net.num_modes(u) {
+                let c = f[(i - 1) * mm + mu as usize] + net.arc(u, mu, v, mv);
+                if c < best.0 {
+                    best = (c, mu);
+                }
+            }
+            f[i * mm + mv as usize] = best.0 + net.mode_cost(v, mv);
+            par[i * mm + mv as usize] = best.1;
+        }
     }
 }

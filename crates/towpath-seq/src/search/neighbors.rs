@@ -251,15 +251,8 @@ fn precedence_depth<C: CostModel>(net: &Net<C>, pts: &[[f64; 3]]) -> Option<Vec<
         return None;
     }
     let n = net.n_tasks;
-    // Kahn's order over the tasks (pins to the depot left out)
-    let mut indegree = vec![0u32; n];
-    for v in 0..n as u32 {
-        for &s in net.successors(v) {
-            if (s as usize) < n {
-                indegree[s as usize] += 1;
-            }
-        }
-    }
+    // Kahn's order over the tasks
+    let mut indegree = net.task_indegrees();
     let mut level = vec![0u32; n];
     let mut ready: Vec<u32> = (0..n as u32).filter(|&v| indegree[v as usize] == 0).collect();
     while let Some(v) = ready.pop() {

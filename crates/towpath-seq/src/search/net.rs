@@ -433,6 +433,21 @@ impl<'p, C: CostModel> Net<'p, C> {
         &self.succ[self.succ_off[v as usize] as usize..self.succ_off[v as usize + 1] as usize]
     }
 
+    /// For each task, how many tasks must come at once before it in the transitive reduction
+    /// (pins to the depot left out): the in-degrees from which a topological order starts.
+    pub fn task_indegrees(&self) -> Vec<u32> {
+        let n = self.n_tasks;
+        let mut indegree = vec![0u32; n];
+        for v in 0..n as u32 {
+            for &s in self.successors(v) {
+                if (s as usize) < n {
+                    indegree[s as usize] += 1;
+                }
+            }
+        }
+        indegree
+    }
+
     /// The nodes that must come before `v`, in the transitive reduction (see
     /// [`Net::successors`]).
     #[inline]

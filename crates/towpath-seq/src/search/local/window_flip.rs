@@ -14,6 +14,7 @@
 
 use super::LocalSearch;
 use crate::cost::{Cost, CostModel};
+use crate::search::modes::relax_layers;
 use crate::search::net::Net;
 use crate::search::tour::Tour;
 
@@ -206,20 +207,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         for c in 0..net.num_modes(first) {
             f[c as usize] = net.arc(p, mp, first, c) + net.mode_cost(first, c);
         }
-        for k in 1..len {
-            let (u, x) = (tour.seq[lo + k - 1], tour.seq[lo + k]);
-            for c in 0..net.num_modes(x) {
-                let mut bestv = (Cost::INFINITY, 0u32);
-                for a in 0..net.num_modes(u) {
-                    let v = f[(k - 1) * m + a as usize] + net.arc(u, a, x, c);
-                    if v < bestv.0 {
-                        bestv = (v, a);
-                    }
-                }
-                f[k * m + c as usize] = bestv.0 + net.mode_cost(x, c);
-                from[k * m + c as usize] = bestv.1;
-            }
-        }
+        relax_layers(net, &tour.seq[lo..=hi], m, &mut f, &mut from);
         let last = tour.seq[hi];
         let mut c = (0..net.num_modes(last))
             .min_by(|&a, &b| {
@@ -294,14 +282,7 @@ mod tests {
     /// the depot first.
     fn random_tour(net: &Net<'_, PointCost>, rng: &mut Pcg64Mcg) -> Tour {
         let n = net.n_tasks;
-        let mut indegree = vec![0usize; n];
-        for v in 0..n as u32 {
-            for &s in net.successors(v) {
-                if (s as usize) < n {
-                    indegree[s as usize] += 1;
-                }
-            }
-        }
+        let mut indegree = net.task_indegrees();
         let mut ready: Vec<u32> = (0..n as u32).filter(|&v| indegree[v as usize] == 0).collect();
         let mut seq = vec![net.depot];
         while !ready.is_empty() {
