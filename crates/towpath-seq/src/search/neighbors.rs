@@ -267,13 +267,7 @@ fn precedence_depth<C: CostModel>(net: &Net<C>, pts: &[[f64; 3]]) -> Option<Vec<
             }
         }
     }
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in pts {
-        for d in 0..2 {
-            lo[d] = lo[d].min(p[d]);
-            hi[d] = hi[d].max(p[d]);
-        }
-    }
+    let (lo, hi) = bounds(pts);
     let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(0.0);
     let spacing = (area / pts.len() as f64).sqrt();
     if !spacing.is_finite() || spacing <= 0.0 {
@@ -389,8 +383,8 @@ fn kd_candidates<C: CostModel>(
     })
 }
 
-/// The diagonal of the points' bounding box.
-fn diagonal(pts: &[[f64; 3]]) -> f64 {
+/// The points' bounding box: its lowest and highest corner.
+fn bounds(pts: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in pts {
         for d in 0..3 {
@@ -398,6 +392,12 @@ fn diagonal(pts: &[[f64; 3]]) -> f64 {
             hi[d] = hi[d].max(p[d]);
         }
     }
+    (lo, hi)
+}
+
+/// The diagonal of the points' bounding box.
+fn diagonal(pts: &[[f64; 3]]) -> f64 {
+    let (lo, hi) = bounds(pts);
     (0..3).map(|d| (hi[d] - lo[d]).max(0.0).powi(2)).sum::<f64>().sqrt()
 }
 

@@ -30,7 +30,7 @@ pub(super) const MAX_MODES: u32 = 4;
 /// Whether the move runs: tasks with modes, no consecutive groups, at most [`MAX_MODES`] modes a
 /// task, and no Lin–Kernighan reversals (`two_opt`) already.
 pub(super) fn applies<C: CostModel>(net: &Net<'_, C>, two_opt: bool) -> bool {
-    net.multi_mode && !two_opt && !net.has_groups && (0..net.n as u32).all(|v| net.num_modes(v) <= MAX_MODES)
+    net.multi_mode && !two_opt && !net.has_groups && net.p.max_modes() <= MAX_MODES as usize
 }
 
 /// Cheapest costs through a turned-round stretch, by the modes of its first and last task in
@@ -96,7 +96,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             let mut next = Table { m: mx, cost: [Cost::INFINITY; (MAX_MODES * MAX_MODES) as usize] };
             for c in 0..mx {
                 let own = net.mode_cost(x, c as u32);
-                for b in 0..table_last_modes(net, x_lo) {
+                for b in 0..net.num_modes(x_lo) as usize {
                     let mut v = Cost::INFINITY;
                     for a in 0..table.m {
                         let t = table.at(a, b);
@@ -176,7 +176,7 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
         let mut new = Cost::INFINITY;
         for a in 0..table.m {
             let into = net.arc(p, mp, x_hi, a as u32);
-            for b in 0..table_last_modes(net, x_lo) {
+            for b in 0..net.num_modes(x_lo) as usize {
                 let t = table.at(a, b);
                 if t < Cost::INFINITY {
                     new = new.min(into + t + net.arc(x_lo, b as u32, q, mq));
@@ -228,12 +228,6 @@ impl<'a, 'p, C: CostModel> LocalSearch<'a, 'p, C> {
             self.push(tour.seq[k]);
         }
     }
-}
-
-/// Modes of the stretch's last task in the new order (the table's second index).
-#[inline]
-fn table_last_modes<C: CostModel>(net: &Net<'_, C>, x_lo: u32) -> usize {
-    net.num_modes(x_lo) as usize
 }
 
 #[cfg(test)]
